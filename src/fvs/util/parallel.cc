@@ -1,0 +1,62 @@
+#include "fvs/util/parallel.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace fvs {
+
+int DefaultNumThreads() {
+  if (const char* env = std::getenv("FVS_NUM_THREADS")) {
+    const int n = std::atoi(env);
+    if (n > 0) return n;
+  }
+  const unsigned hw = std::thread::hardware_concurrency();
+  return hw > 0 ? static_cast<int>(hw) : 1;
+}
+
+void ParallelForRanges(int64_t begin, int64_t end,
+                       const std::function<void(int64_t, int64_t, int)>& fn,
+                       int num_threads) {
+  if (end <= begin) return;
+  if (num_threads <= 0) num_threads = DefaultNumThreads();
+  const int64_t n = end - begin;
+  const int threads = static_cast<int>(std::min<int64_t>(num_threads, n));
+  if (threads <= 1) {
+    fn(begin, end, 0);
+    return;
+  }
+  std::exception_ptr first_error;
+  std::mutex mutex;
+  std::vector<std::thread> workers;
+  workers.reserve(threads);
+  for (int t = 0; t < threads; ++t) {
+    const int64_t b = begin + n * t / threads;
+    const int64_t e = begin + n * (t + 1) / threads;
+    workers.emplace_back([&, b, e, t] {
+      try {
+        fn(b, e, t);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!first_error) first_error = std::current_exception();
+      }
+    });
+  }
+  for (auto& w : workers) w.join();
+  if (first_error) std::rethrow_exception(first_error);
+}
+
+void ParallelFor(int64_t begin, int64_t end, const std::function<void(int64_t)>& fn,
+                 int num_threads) {
+  ParallelForRanges(
+      begin, end,
+      [&fn](int64_t b, int64_t e, int) {
+        for (int64_t i = b; i < e; ++i) fn(i);
+      },
+      num_threads);
+}
+
+}  // namespace fvs

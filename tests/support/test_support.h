@@ -1,0 +1,34 @@
+// Shared test helpers: temporary folders that clean up, paths of the build.
+#pragma once
+
+#include <string>
+
+namespace fvs::testing {
+
+// A fresh, empty folder under $TMPDIR (or /tmp), removed with its contents on destruction
+// unless FVS_KEEP_TEST_DIRS=1.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::string& path() const { return path_; }
+  std::string operator/(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+// build/bin/colmap, our front door.
+std::string FrontDoorBinary();
+// The real COLMAP: $FVS_COLMAP_BIN or `colmap` on the PATH (not our front door).
+std::string RealColmapBinary();
+
+// Runs a shell command, returns its exit status; output goes to *output when given.
+int RunShell(const std::string& command, std::string* output = nullptr);
+
+void WriteTextFile(const std::string& path, const std::string& text);
+std::string ReadTextFile(const std::string& path);
+
+}  // namespace fvs::testing
