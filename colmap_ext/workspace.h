@@ -1,0 +1,42 @@
+// Paths of a COLMAP dense workspace (as written by image_undistorter) plus our fvs/ folder:
+//   W/images/  W/sparse/  W/stereo/{depth_maps,normal_maps}/<name>.<type>.bin
+//   W/fused.ply(.vis)  W/meshed-delaunay.ply  W/fvs/
+#pragma once
+
+#include <string>
+
+namespace fvs::colmap {
+
+struct DenseWorkspace {
+  std::string root;
+
+  explicit DenseWorkspace(std::string root_path) : root(std::move(root_path)) {}
+
+  std::string ImagesDir() const { return root + "/images"; }
+  std::string SparseDir() const { return root + "/sparse"; }
+  std::string StereoDir() const { return root + "/stereo"; }
+  std::string ImagePath(const std::string& name) const { return ImagesDir() + "/" + name; }
+  // type: "photometric" or "geometric".
+  std::string DepthMapPath(const std::string& name, const std::string& type) const {
+    return root + "/stereo/depth_maps/" + name + "." + type + ".bin";
+  }
+  std::string NormalMapPath(const std::string& name, const std::string& type) const {
+    return root + "/stereo/normal_maps/" + name + "." + type + ".bin";
+  }
+  std::string FusedPath() const { return root + "/fused.ply"; }
+  std::string FusedVisPath() const { return root + "/fused.ply.vis"; }
+  std::string DelaunayMeshPath() const { return root + "/meshed-delaunay.ply"; }
+  std::string PoissonMeshPath() const { return root + "/meshed-poisson.ply"; }
+  std::string FvsDir() const { return root + "/fvs"; }
+  std::string SourceDepthPath(const std::string& name) const {
+    return root + "/fvs/depth/" + name + ".bin";
+  }
+  std::string ManifestPath() const { return root + "/fvs/manifest.json"; }
+};
+
+// Throws fvs::Error naming what is missing when `root` has no images/ or no sparse model.
+void CheckDenseWorkspace(const DenseWorkspace& workspace);
+// Creates a folder and its parents; throws fvs::Error on failure.
+void CreateDirectories(const std::string& path);
+
+}  // namespace fvs::colmap
