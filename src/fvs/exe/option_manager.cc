@@ -1,0 +1,201 @@
+#include "fvs/exe/option_manager.h"
+
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+
+#include "fvs/util/error.h"
+
+namespace fvs {
+namespace {
+
+std::string StripDashes(const std::string& arg) {
+  size_t i = 0;
+  while (i < arg.size() && i < 2 && arg[i] == '-') ++i;
+  return arg.substr(i);
+}
+
+bool ParseBool(const std::string& s, bool* value) {
+  if (s == "1" || s == "true" || s == "True" || s == "TRUE") {
+    *value = true;
+    return true;
+  }
+  if (s == "0" || s == "false" || s == "False" || s == "FALSE") {
+    *value = false;
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+OptionManager::OptionManager(std::string command, std::string description)
+    : command_(std::move(command)), description_(std::move(description)) {}
+
+void OptionManager::Add(const std::string& name, Option::Kind kind, void* target,
+                        bool required, const std::string& help) {
+  for (const Option& o : options_) {
+    if (o.name == name) throw Error("option --" + name + " registered twice");
+  }
+  Option option;
+  option.name = name;
+  option.kind = kind;
+  option.target = target;
+  option.required = required;
+  option.help = help;
+  options_.push_back(option);
+}
+
+void OptionManager::AddRequired(const std::string& name, std::string* value,
+                                const std::string& help) {
+  Add(name, Option::Kind::kString, value, true, help);
+}
+void OptionManager::AddDefault(const std::string& name, std::string* value,
+                               const std::string& help) {
+  Add(name, Option::Kind::kString, value, false, help);
+}
+void OptionManager::AddDefault(const std::string& name, int* value,
+                               const std::string& help) {
+  Add(name, Option::Kind::kInt, value, false, help);
+}
+void OptionManager::AddDefault(const std::string& name, double* value,
+                               const std::string& help) {
+  Add(name, Option::Kind::kDouble, value, false, help);
+}
+void OptionManager::AddDefault(const std::string& name, bool* value,
+                               const std::string& help) {
+  Add(name, Option::Kind::kBool, value, false, help);
+}
+
+std::string OptionManager::ValueString(const Option& option) const {
+  std::ostringstream s;
+  switch (option.kind) {
+    case Option::Kind::kString:
+      s << *static_cast<std::string*>(option.target);
+      break;
+    case Option::Kind::kInt:
+      s << *static_cast<int*>(option.target);
+      break;
+    case Option::Kind::kDouble:
+      s.precision(17);
+      s << *static_cast<double*>(option.target);
+      break;
+    case Option::Kind::kBool:
+      s << (*static_cast<bool*>(option.target) ? 1 : 0);
+      break;
+  }
+  return s.str();
+}
+
+std::string OptionManager::Usage() const {
+  std::ostringstream s;
+  s << "Usage: colmap " << command_ << " [options]\n\n" << description_ << "\n\nOptions:\n";
+  s << "  -h [ --help ]\n";
+  for (const Option& o : options_) {
+    s << "  --" << o.name;
+    if (o.required) {
+      s << " arg (required)";
+    } else {
+      s << " arg (=" << ValueString(o) << ")";
+    }
+    if (!o.help.empty()) s << "\n      " << o.help;
+    s << "\n";
+  }
+  return s.str();
+}
+
+std::string OptionManager::Describe() const {
+  std::ostringstream s;
+  for (size_t i = 0; i < options_.size(); ++i) {
+    if (i) s << " ";
+    s << "--" << options_[i].name << " " << ValueString(options_[i]);
+  }
+  return s.str();
+}
+
+bool OptionManager::Parse(int argc, char** argv, int first) {
+  for (int i = first; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "-h" || arg == "--help") {
+      std::cout << Usage();
+      return false;
+    }
+  }
+  for (int i = first; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.size() < 2 || arg[0] != '-') {
+      throw Error("colmap " + command_, "unexpected argument '" + arg +
+                                            "' (options are --name value; see -h)");
+    }
+    std::string name = StripDashes(arg);
+    std::string value;
+    bool has_value = false;
+    const size_t eq = name.find('=');
+    if (eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+      has_value = true;
+    }
+    Option* option = nullptr;
+    for (Option& o : options_) {
+      if (o.name == name) option = &o;
+    }
+    if (option == nullptr) {
+      throw Error("colmap " + command_, "unknown option --" + name + " (see -h)");
+    }
+    if (!has_value) {
+      if (i + 1 >= argc) {
+        throw Error("colmap " + command_, "option --" + name + " needs a value");
+      }
+      value = argv[++i];
+    }
+    const std::string where = "colmap " + command_;
+    switch (option->kind) {
+      case Option::Kind::kString:
+        *static_cast<std::string*>(option->target) = value;
+        break;
+      case Option::Kind::kInt: {
+        char* end = nullptr;
+        errno = 0;
+        const long v = std::strtol(value.c_str(), &end, 10);
+        if (value.empty() || *end != '\0' || errno != 0 || v < INT32_MIN || v > INT32_MAX) {
+          throw Error(where, "option --" + name + " expects an integer, got '" + value + "'");
+        }
+        *static_cast<int*>(option->target) = static_cast<int>(v);
+        break;
+      }
+      case Option::Kind::kDouble: {
+        char* end = nullptr;
+        const double v = std::strtod(value.c_str(), &end);
+        if (value.empty() || *end != '\0' || !std::isfinite(v)) {
+          throw Error(where,
+                      "option --" + name + " expects a finite number, got '" + value + "'");
+        }
+        *static_cast<double*>(option->target) = v;
+        break;
+      }
+      case Option::Kind::kBool: {
+        bool v = false;
+        if (!ParseBool(value, &v)) {
+          throw Error(where, "option --" + name + " expects 0/1/true/false, got '" +
+                                 value + "'");
+        }
+        *static_cast<bool*>(option->target) = v;
+        break;
+      }
+    }
+    option->seen = true;
+  }
+  for (const Option& o : options_) {
+    if (o.required && !o.seen) {
+      throw Error("colmap " + command_, "missing required option --" + o.name);
+    }
+  }
+  return true;
+}
+
+}  // namespace fvs
