@@ -1,0 +1,403 @@
+#include "fvs/exe/prepare_stages.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "colmap_ext/reconstruction.h"
+#include "colmap_ext/runner.h"
+#include "colmap_ext/sparse_io.h"
+#include "colmap_ext/workspace.h"
+#include "fvs/exe/command_registry.h"
+#include "fvs/util/atomic_file.h"
+#include "fvs/util/error.h"
+#include "fvs/util/manifest.h"
+#include "fvs/util/progress.h"
+#include "fvs/util/string_util.h"
+
+namespace fvs {
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kWho = "colmap view_synthesis_prepare";
+
+// FNV-1a: a stable digest for chaining fingerprints (std::hash is not stable across builds).
+std::string Digest(const std::string& text) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  std::ostringstream s;
+  s << std::hex << h;
+  return s.str();
+}
+
+void RemoveAll(const std::string& path) {
+  std::error_code ec;
+  fs::remove_all(path, ec);
+}
+
+// Replaces `to` by `from` (both folders or files) as atomically as the file system allows:
+// the old output is moved aside first, so at every instant either the old or the new one is
+// complete.
+void MoveIntoPlace(const std::string& from, const std::string& to) {
+  std::error_code ec;
+  const std::string old = to + ".old-fvs";
+  RemoveAll(old);
+  if (fs::exists(to, ec)) fs::rename(to, old, ec);
+  fs::rename(from, to, ec);
+  if (ec) throw Error(to, "cannot move stage output into place (" + ec.message() + ")");
+  RemoveAll(old);
+}
+
+std::vector<std::string> CommandArgs(const std::string& command,
+                                     const std::vector<std::string>& options) {
+  std::vector<std::string> args = {"colmap", command};
+  args.insert(args.end(), options.begin(), options.end());
+  return args;
+}
+
+// Runs one of our registered commands in-process.
+void RunOurCommand(const std::string& command, const std::vector<std::string>& options) {
+  const CommandInfo* info = FindCommand(command);
+  if (info == nullptr) {
+    throw Error(kWho, "this build has no " + command + " command");
+  }
+  std::vector<std::string> args = CommandArgs(command, options);
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const int status = info->function(static_cast<int>(args.size()), argv.data());
+  if (status != 0) throw Error(kWho, command + " failed (exit " + std::to_string(status) + ")");
+}
+
+struct StageRunner {
+  Manifest manifest;
+  std::string previous;  // chained fingerprint digest
+  int index = 0;
+  int total = 0;
+
+  // Runs `run` unless the manifest says the stage is up to date.
+  void Run(const std::string& name, const std::vector<std::string>& inputs,
+           const std::string& options, const std::vector<std::string>& outputs,
+           const std::function<void()>& run) {
+    ++index;
+    const std::string fingerprint =
+        Digest(previous + "\n" + Manifest::Fingerprint(inputs, options));
+    previous = fingerprint;
+    if (manifest.IsUpToDate(name, fingerprint, outputs)) {
+      std::cerr << "[" << index << "/" << total << "] " << name
+                << ": up to date, skipped\n";
+      return;
+    }
+    std::cerr << "[" << index << "/" << total << "] " << name << " ...\n";
+    manifest.Forget(name);
+    manifest.Save();
+    Timer timer;
+    run();
+    const double seconds = timer.Seconds();
+    manifest.Record(name, fingerprint, outputs, seconds);
+    manifest.Save();
+    std::cerr << "[" << index << "/" << total << "] " << name << ": done in " << seconds
+              << " s\n";
+  }
+};
+
+bool IsImageExtension(std::string ext) {
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".tif" ||
+         ext == ".tiff" || ext == ".bmp" || ext == ".ppm" || ext == ".pgm";
+}
+
+}  // namespace
+
+std::set<std::string> ParseHoldoutList(const std::string& spec) {
+  std::set<std::string> names;
+  if (spec.empty()) return names;
+  std::error_code ec;
+  if (fs::is_regular_file(spec, ec)) {
+    std::istringstream lines(ReadFileToString(spec));
+    std::string line;
+    while (std::getline(lines, line)) {
+      line = TrimString(line);
+      if (!line.empty() && line[0] != '#') names.insert(line);
+    }
+    return names;
+  }
+  for (const std::string& part : SplitString(spec, ",")) {
+    const std::string name = TrimString(part);
+    if (!name.empty()) names.insert(name);
+  }
+  return names;
+}
+
+std::vector<std::string> ListImageFiles(const std::string& folder) {
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) throw Error(folder, "image folder does not exist");
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    if (entry.is_regular_file() && IsImageExtension(entry.path().extension().string())) {
+      names.push_back(entry.path().filename().string());
+    }
+  }
+  std::sort(names.begin(), names.end());
+  if (names.empty()) throw Error(folder, "no images (.jpg, .png, .tif, ...) in this folder");
+  return names;
+}
+
+bool LooksLikeVideoFrames(const std::vector<std::string>& names) {
+  if (names.size() < 10) return false;
+  // Strip the extension and the trailing digits: all the same prefix, numbers consecutive.
+  std::string prefix;
+  long last = -1;
+  int consecutive = 0;
+  for (size_t i = 0; i < names.size(); ++i) {
+    std::string stem = fs::path(names[i]).stem().string();
+    size_t d = stem.size();
+    while (d > 0 && std::isdigit(static_cast<unsigned char>(stem[d - 1]))) --d;
+    if (d == stem.size()) return false;
+    const std::string p = stem.substr(0, d);
+    const long n = std::stol(stem.substr(d, 15));
+    if (i == 0) prefix = p;
+    if (p != prefix) return false;
+    if (last >= 0 && n == last + 1) ++consecutive;
+    last = n;
+  }
+  return consecutive >= static_cast<int>(names.size() * 9 / 10);
+}
+
+void WriteStereoConfigs(const std::string& workspace_path,
+                        const std::set<std::string>& holdout, int max_sources) {
+  const colmap::DenseWorkspace ws(workspace_path);
+  const colmap::Reconstruction rec = colmap::ReadSparseModel(ws.SparseDir());
+  // Shared 3D points between image pairs rank the sources, as COLMAP's __auto__ does.
+  std::map<uint32_t, std::map<uint32_t, int>> shared;
+  for (const auto& [id, point] : rec.points3D) {
+    std::set<uint32_t> images;
+    for (const auto& el : point.track) images.insert(el.image_id);
+    for (uint32_t a : images) {
+      for (uint32_t b : images) {
+        if (a != b) ++shared[a][b];
+      }
+    }
+  }
+  std::ostringstream patch_match, fusion;
+  for (const auto& [id, image] : rec.images) {
+    if (holdout.count(image.name)) continue;
+    std::vector<std::pair<int, uint32_t>> ranked;
+    for (const auto& [other, count] : shared[id]) {
+      if (!holdout.count(rec.images.at(other).name)) ranked.push_back({-count, other});
+    }
+    std::sort(ranked.begin(), ranked.end());
+    if (ranked.empty()) continue;  // sees nothing in common: no depth map possible
+    patch_match << image.name << "\n";
+    for (size_t i = 0; i < ranked.size() && static_cast<int>(i) < max_sources; ++i) {
+      patch_match << (i ? ", " : "") << rec.images.at(ranked[i].second).name;
+    }
+    patch_match << "\n";
+    fusion << image.name << "\n";
+  }
+  colmap::CreateDirectories(ws.StereoDir());
+  WriteFileAtomic(ws.StereoDir() + "/patch-match.cfg",
+                  [&](std::ostream& out) { out << patch_match.str(); });
+  WriteFileAtomic(ws.StereoDir() + "/fusion.cfg",
+                  [&](std::ostream& out) { out << fusion.str(); });
+}
+
+void RunPrepareStages(const PrepareContext& c) {
+  const std::vector<std::string> images = ListImageFiles(c.image_path);
+  for (const std::string& name : c.holdout) {
+    if (!std::binary_search(images.begin(), images.end(), name)) {
+      throw Error(c.image_path, "holdout image '" + name + "' is not in this folder");
+    }
+  }
+  if (images.size() < 3) {
+    throw Error(c.image_path, "only " + std::to_string(images.size()) +
+                                  " images: view synthesis needs at least 3 photos");
+  }
+  const colmap::DenseWorkspace ws(c.workspace_path);
+  const std::string fvs_dir = ws.FvsDir();
+  const std::string tmp_dir = fvs_dir + "/tmp";
+  colmap::CreateDirectories(fvs_dir);
+  RemoveAll(tmp_dir);  // leftovers of a killed run: never trusted
+  colmap::CreateDirectories(tmp_dir);
+
+  const colmap::ColmapCapabilities& colmap_caps = colmap::ProbeColmap();
+  const std::string threads = std::to_string(c.num_threads);
+  const std::string database = c.workspace_path + "/database.db";
+  const std::string sfm_model = c.workspace_path + "/sfm/0";
+
+  std::string matcher = c.matcher;
+  if (matcher == "auto") {
+    matcher = LooksLikeVideoFrames(images) ? "sequential"
+              : images.size() > 150        ? "sequential"
+                                           : "exhaustive";
+  }
+  const bool builtin_stereo =
+      c.stereo_backend == "builtin" ||
+      (c.stereo_backend == "auto" && !colmap_caps.has_cuda);
+  const bool builtin_mesher =
+      c.mesher_backend == "builtin" ||
+      (c.mesher_backend == "auto" && !colmap_caps.has_cgal);
+  if (c.stereo_backend == "colmap" && !colmap_caps.has_cuda) {
+    throw Error(kWho, "--Stereo.backend colmap needs a COLMAP built with CUDA; " +
+                          colmap_caps.executable + " has none (use builtin or auto)");
+  }
+  if (c.mesher_backend == "colmap" && !colmap_caps.has_cgal) {
+    throw Error(kWho, "--Mesher.backend colmap needs a COLMAP built with CGAL; " +
+                          colmap_caps.executable + " has none (use builtin or auto)");
+  }
+  std::string holdout_list;
+  for (const std::string& h : c.holdout) holdout_list += h + ",";
+
+  StageRunner stages;
+  stages.manifest = Manifest::Load(ws.ManifestPath());
+  stages.total = 8;
+  const std::string gpu = colmap_caps.has_cuda ? "1" : "0";
+
+  stages.Run("feature_extraction", {c.image_path},
+             c.camera_model + " single=" + std::to_string(c.single_camera) +
+                 " size=" + std::to_string(c.max_image_size),
+             {database}, [&] {
+               // A database left by a killed extraction is incomplete: start over.
+               const std::string tmp_db = tmp_dir + "/database.db";
+               colmap::RunColmap(
+                   {"feature_extractor", "--database_path", tmp_db, "--image_path",
+                    c.image_path, "--ImageReader.camera_model", c.camera_model,
+                    "--ImageReader.single_camera", c.single_camera ? "1" : "0",
+                    "--SiftExtraction.use_gpu", gpu, "--SiftExtraction.max_image_size",
+                    std::to_string(c.max_image_size), "--SiftExtraction.num_threads",
+                    threads});
+               MoveIntoPlace(tmp_db, database);
+             });
+
+  stages.Run("matching", {}, matcher, {database}, [&] {
+    // Matching writes into the database: work on a copy, so a kill leaves the extracted
+    // features untouched.
+    const std::string tmp_db = tmp_dir + "/database.db";
+    fs::copy_file(database, tmp_db, fs::copy_options::overwrite_existing);
+    colmap::RunColmap({matcher + "_matcher", "--database_path", tmp_db,
+                       "--SiftMatching.use_gpu", gpu, "--SiftMatching.num_threads",
+                       threads});
+    MoveIntoPlace(tmp_db, database);
+  });
+
+  stages.Run("mapping", {}, "", {sfm_model}, [&] {
+    const std::string out = tmp_dir + "/sfm";
+    colmap::CreateDirectories(out);
+    colmap::RunColmap({"mapper", "--database_path", database, "--image_path",
+                       c.image_path, "--output_path", out, "--Mapper.num_threads",
+                       threads});
+    // The largest model is the scene (COLMAP numbers models by discovery, not size).
+    std::string best;
+    size_t best_images = 0;
+    for (const auto& entry : fs::directory_iterator(out)) {
+      if (!entry.is_directory()) continue;
+      const colmap::Reconstruction rec = colmap::ReadSparseModel(entry.path().string());
+      if (rec.images.size() > best_images) {
+        best_images = rec.images.size();
+        best = entry.path().string();
+      }
+    }
+    if (best.empty() || best_images < 3) {
+      throw Error(c.image_path, "SfM registered " + std::to_string(best_images) + " of " +
+                                    std::to_string(images.size()) +
+                                    " images: too few for view synthesis (photos need "
+                                    "more overlap and texture)");
+    }
+    std::cerr << "  registered " << best_images << " of " << images.size() << " images\n";
+    colmap::CreateDirectories(c.workspace_path + "/sfm");
+    MoveIntoPlace(best, sfm_model);
+  });
+
+  stages.Run("undistortion", {}, "size=" + std::to_string(c.max_image_size) + " holdout=" +
+                                     holdout_list,
+             {ws.ImagesDir(), ws.SparseDir()}, [&] {
+               const std::string out = tmp_dir + "/undistorted";
+               colmap::CreateDirectories(out);
+               colmap::RunColmap({"image_undistorter", "--image_path", c.image_path,
+                                  "--input_path", sfm_model, "--output_path", out,
+                                  "--output_type", "COLMAP", "--max_image_size",
+                                  std::to_string(c.max_image_size)});
+               const colmap::Reconstruction rec =
+                   colmap::ReadSparseModel(out + "/sparse");
+               for (const std::string& h : c.holdout) {
+                 if (rec.FindImageByName(h) == nullptr) {
+                   throw Error(c.image_path, "holdout image '" + h +
+                                                 "' was not registered by SfM");
+                 }
+               }
+               colmap::CreateDirectories(ws.StereoDir());
+               MoveIntoPlace(out + "/images", ws.ImagesDir());
+               MoveIntoPlace(out + "/sparse", ws.SparseDir());
+               WriteStereoConfigs(c.workspace_path, c.holdout);
+               WriteFileAtomic(fvs_dir + "/holdout.txt", [&](std::ostream& o) {
+                 for (const std::string& h : c.holdout) o << h << "\n";
+               });
+             });
+
+  const std::string depth_dir = ws.StereoDir() + "/depth_maps";
+  stages.Run("stereo", {}, std::string(builtin_stereo ? "builtin" : "colmap") +
+                               " size=" + std::to_string(c.stereo_max_image_size),
+             {depth_dir}, [&] {
+               if (builtin_stereo) {
+                 std::vector<std::string> args = {"--workspace_path", c.workspace_path};
+                 if (c.stereo_max_image_size > 0) {
+                   args.push_back("--PatchMatchStereo.max_image_size");
+                   args.push_back(std::to_string(c.stereo_max_image_size));
+                 }
+                 RunOurCommand("view_synthesis_stereo", args);
+               } else {
+                 colmap::RunColmap({"patch_match_stereo", "--workspace_path",
+                                    c.workspace_path, "--workspace_format", "COLMAP",
+                                    "--PatchMatchStereo.geom_consistency", "1",
+                                    "--PatchMatchStereo.max_image_size",
+                                    std::to_string(c.stereo_max_image_size > 0
+                                                       ? c.stereo_max_image_size
+                                                       : -1)});
+               }
+             });
+
+  stages.Run("fusion", {}, "", {ws.FusedPath(), ws.FusedVisPath()}, [&] {
+    const std::string out = tmp_dir + "/fused.ply";
+    colmap::RunColmap({"stereo_fusion", "--workspace_path", c.workspace_path,
+                       "--workspace_format", "COLMAP", "--input_type", "geometric",
+                       "--output_path", out, "--StereoFusion.num_threads", threads});
+    std::error_code ec;
+    if (!fs::exists(out, ec) || fs::file_size(out, ec) < 300) {
+      throw Error(ws.FusedPath(), "stereo fusion produced no points (the depth maps are "
+                                  "empty: too little texture or overlap?)");
+    }
+    MoveIntoPlace(out + ".vis", ws.FusedVisPath());
+    MoveIntoPlace(out, ws.FusedPath());
+  });
+
+  stages.Run("meshing", {}, builtin_mesher ? "builtin" : "colmap", {ws.DelaunayMeshPath()},
+             [&] {
+               if (builtin_mesher) {
+                 RunOurCommand("view_synthesis_mesher",
+                               {"--workspace_path", c.workspace_path});
+               } else {
+                 const std::string out = tmp_dir + "/meshed-delaunay.ply";
+                 colmap::RunColmap({"delaunay_mesher", "--input_path", c.workspace_path,
+                                    "--input_type", "dense", "--output_path", out});
+                 MoveIntoPlace(out, ws.DelaunayMeshPath());
+               }
+             });
+
+  stages.Run("depth_cache", {}, "", {ws.FvsDir() + "/depth"}, [&] {
+    RunOurCommand("view_synthesis_depth_cache", {"--workspace_path", c.workspace_path});
+  });
+  RemoveAll(tmp_dir);
+  std::cerr << "Scene ready: " << c.workspace_path << "\n";
+}
+
+}  // namespace fvs

@@ -1,0 +1,41 @@
+// colmap view_synthesis_depth_cache --workspace_path W: renders the depth of every source
+// view from W/meshed-delaunay.ply into W/fvs/depth/ (reusing what is current). The last
+// stage of view_synthesis_prepare; on its own after a mesh was replaced.
+#include <iostream>
+
+#include "fvs/exe/command_registry.h"
+#include "fvs/exe/option_manager.h"
+#include "fvs/scene/scene.h"
+#include "fvs/util/progress.h"
+
+namespace fvs {
+namespace {
+
+int RunDepthCache(int argc, char** argv) {
+  std::string workspace_path;
+  int num_threads = -1;
+  OptionManager options("view_synthesis_depth_cache",
+                        "Render the depth of every source view from the proxy mesh into "
+                        "W/fvs/depth/ (COLMAP .bin arrays, 0 = no surface).");
+  options.AddRequired("workspace_path", &workspace_path, "dense workspace");
+  options.AddDefault("num_threads", &num_threads, "-1 = all cores");
+  if (!options.Parse(argc, argv)) return 0;
+  SceneLoadOptions load;
+  load.use_depth_cache = true;
+  load.num_threads = num_threads;
+  Timer timer;
+  const Scene scene = Scene::Load(workspace_path, load);
+  std::cerr << "depth cache: " << scene.num_views() << " views, "
+            << scene.num_depths_computed() << " rendered, "
+            << scene.num_views() - scene.num_depths_computed() << " reused, "
+            << timer.Seconds() << " s\n";
+  return 0;
+}
+
+}  // namespace
+
+FVS_REGISTER_COMMAND("view_synthesis_depth_cache",
+                     "render source depths from the proxy mesh into W/fvs/depth",
+                     RunDepthCache);
+
+}  // namespace fvs
