@@ -1,5 +1,6 @@
 // COLMAP's camera models (ids, names, parameter layouts and distortion as in COLMAP 3.8's
-// src/base/camera_models.h): projection of normalised camera coordinates to pixels and back.
+// src/base/camera_models.h): projection of normalised camera coordinates to pixels and
+// back.
 #pragma once
 
 #include <Eigen/Core>
@@ -9,17 +10,17 @@
 namespace fvs::colmap {
 
 enum CameraModelId : int {
-  kSimplePinhole = 0,       // f, cx, cy
-  kPinhole = 1,             // fx, fy, cx, cy
-  kSimpleRadial = 2,        // f, cx, cy, k
-  kRadial = 3,              // f, cx, cy, k1, k2
-  kOpenCV = 4,              // fx, fy, cx, cy, k1, k2, p1, p2
-  kOpenCVFisheye = 5,       // fx, fy, cx, cy, k1, k2, k3, k4
-  kFullOpenCV = 6,          // fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6
-  kFOV = 7,                 // fx, fy, cx, cy, omega
-  kSimpleRadialFisheye = 8, // f, cx, cy, k
-  kRadialFisheye = 9,       // f, cx, cy, k1, k2
-  kThinPrismFisheye = 10,   // fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, sx1, sy1
+  kSimplePinhole = 0,        // f, cx, cy
+  kPinhole = 1,              // fx, fy, cx, cy
+  kSimpleRadial = 2,         // f, cx, cy, k
+  kRadial = 3,               // f, cx, cy, k1, k2
+  kOpenCV = 4,               // fx, fy, cx, cy, k1, k2, p1, p2
+  kOpenCVFisheye = 5,        // fx, fy, cx, cy, k1, k2, k3, k4
+  kFullOpenCV = 6,           // fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6
+  kFOV = 7,                  // fx, fy, cx, cy, omega
+  kSimpleRadialFisheye = 8,  // f, cx, cy, k
+  kRadialFisheye = 9,        // f, cx, cy, k1, k2
+  kThinPrismFisheye = 10,    // fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, sx1, sy1
 };
 constexpr int kNumCameraModels = 11;
 

@@ -1,5 +1,6 @@
-// Reading COLMAP's database.db (sqlite): cameras and images (names, camera ids, prior poses),
-// keypoint counts. Read-only; throws fvs::Error naming the file on anything unexpected.
+// Reading COLMAP's database.db (sqlite): cameras and images (names, camera ids, prior
+// poses), keypoint counts. Read-only; throws fvs::Error naming the file on anything
+// unexpected.
 #pragma once
 
 #include <cstdint>
@@ -20,8 +21,8 @@ struct DatabaseImage {
 struct DatabaseContents {
   std::map<uint32_t, Camera> cameras;
   std::map<uint32_t, DatabaseImage> images;
-  int num_matched_pairs = 0;          // rows of `matches` with at least one match
-  int num_verified_pairs = 0;         // rows of `two_view_geometries` with inliers
+  int num_matched_pairs = 0;   // rows of `matches` with at least one match
+  int num_verified_pairs = 0;  // rows of `two_view_geometries` with inliers
 };
 
 DatabaseContents ReadDatabase(const std::string& path);

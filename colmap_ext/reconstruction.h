@@ -1,5 +1,5 @@
-// COLMAP's sparse model in memory: cameras, images (poses + 2D points) and 3D points, with
-// the ids and conventions of COLMAP 3.8 (qvec = (w, x, y, z), world-to-camera pose).
+// COLMAP's sparse model in memory: cameras, images (poses + 2D points) and 3D points,
+// with the ids and conventions of COLMAP 3.8 (qvec = (w, x, y, z), world-to-camera pose).
 #pragma once
 
 #include <Eigen/Core>
@@ -58,15 +58,15 @@ struct Reconstruction {
   std::map<uint32_t, Image> images;
   std::map<uint64_t, Point3D> points3D;
 
-  // Throws fvs::Error(subject, ...) on what would break later stages: unknown camera model,
-  // wrong parameter count, zero image size, non-finite parameters or poses, a zero
+  // Throws fvs::Error(subject, ...) on what would break later stages: unknown camera
+  // model, wrong parameter count, zero image size, non-finite parameters or poses, a zero
   // quaternion, images referring to missing cameras.
   void Check(const std::string& subject) const;
 
   const Image* FindImageByName(const std::string& name) const;
 
-  // The pinhole camera of an image whose camera model is SIMPLE_PINHOLE or PINHOLE (what an
-  // undistorted dense workspace holds). Throws fvs::Error for distorted models.
+  // The pinhole camera of an image whose camera model is SIMPLE_PINHOLE or PINHOLE (what
+  // an undistorted dense workspace holds). Throws fvs::Error for distorted models.
   PinholeCamera PinholeFor(uint32_t image_id) const;
 };
 

@@ -1,6 +1,6 @@
-// Finding and running the real COLMAP executable: $FVS_COLMAP_BIN, else `colmap` on the PATH
-// that is not our own front door. Probing what it can do (version, CUDA, CGAL) by running it,
-// never by assuming (Debian's COLMAP 3.8 has neither CUDA nor CGAL).
+// Finding and running the real COLMAP executable: $FVS_COLMAP_BIN, else `colmap` on the
+// PATH that is not our own front door. Probing what it can do (version, CUDA, CGAL) by
+// running it, never by assuming (Debian's COLMAP 3.8 has neither CUDA nor CGAL).
 #pragma once
 
 #include <functional>
@@ -11,9 +11,9 @@ namespace fvs::colmap {
 
 struct ColmapCapabilities {
   std::string executable;
-  std::string version;   // e.g. "3.8"
-  bool has_cuda = false; // patch_match_stereo works
-  bool has_cgal = false; // delaunay_mesher works
+  std::string version;    // e.g. "3.8"
+  bool has_cuda = false;  // patch_match_stereo works
+  bool has_cgal = false;  // delaunay_mesher works
 };
 
 // Throws fvs::Error when no COLMAP executable can be found.
@@ -28,8 +28,9 @@ struct RunColmapOptions {
   std::string label;  // shown in progress and error messages, defaults to the command
 };
 
-// Runs `colmap <args...>`. Throws fvs::Error with one line ("colmap <command> failed (exit
-// N): <the last error-looking line COLMAP printed>") on a non-zero exit or signal.
-void RunColmap(const std::vector<std::string>& args, const RunColmapOptions& options = {});
+// Runs `colmap <args...>`. Throws fvs::Error with one line ("colmap <command> failed
+// (exit N): <the last error-looking line COLMAP printed>") on a non-zero exit or signal.
+void RunColmap(const std::vector<std::string>& args,
+               const RunColmapOptions& options = {});
 
 }  // namespace fvs::colmap

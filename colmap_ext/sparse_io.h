@@ -1,7 +1,7 @@
-// Reading and writing COLMAP sparse models (cameras, images, points3D) in the binary (.bin)
-// and text (.txt) formats of COLMAP 3.8, bit-exact both ways. Bad files throw fvs::Error
-// naming the file and the fault (truncated, unknown camera model, wrong parameter count,
-// non-finite pose, dangling ids). Writers are atomic per file.
+// Reading and writing COLMAP sparse models (cameras, images, points3D) in the binary
+// (.bin) and text (.txt) formats of COLMAP 3.8, bit-exact both ways. Bad files throw
+// fvs::Error naming the file and the fault (truncated, unknown camera model, wrong
+// parameter count, non-finite pose, dangling ids). Writers are atomic per file.
 #pragma once
 
 #include <string>

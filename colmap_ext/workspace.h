@@ -1,4 +1,5 @@
-// Paths of a COLMAP dense workspace (as written by image_undistorter) plus our fvs/ folder:
+// Paths of a COLMAP dense workspace (as written by image_undistorter) plus our fvs/
+// folder:
 //   W/images/  W/sparse/  W/stereo/{depth_maps,normal_maps}/<name>.<type>.bin
 //   W/fused.ply(.vis)  W/meshed-delaunay.ply  W/fvs/
 #pragma once
@@ -6,6 +7,8 @@
 #include <string>
 
 namespace fvs::colmap {
+
+struct Reconstruction;  // reconstruction.h
 
 struct DenseWorkspace {
   std::string root;
@@ -15,7 +18,9 @@ struct DenseWorkspace {
   std::string ImagesDir() const { return root + "/images"; }
   std::string SparseDir() const { return root + "/sparse"; }
   std::string StereoDir() const { return root + "/stereo"; }
-  std::string ImagePath(const std::string& name) const { return ImagesDir() + "/" + name; }
+  std::string ImagePath(const std::string& name) const {
+    return ImagesDir() + "/" + name;
+  }
   // type: "photometric" or "geometric".
   std::string DepthMapPath(const std::string& name, const std::string& type) const {
     return root + "/stereo/depth_maps/" + name + "." + type + ".bin";
@@ -36,6 +41,10 @@ struct DenseWorkspace {
 
 // Throws fvs::Error naming what is missing when `root` has no images/ or no sparse model.
 void CheckDenseWorkspace(const DenseWorkspace& workspace);
+// Throws fvs::Error naming the first image of `reconstruction` that has no file in
+// images/ (a workspace copied without all its images).
+void CheckWorkspaceImages(const DenseWorkspace& workspace,
+                          const Reconstruction& reconstruction);
 // Creates a folder and its parents; throws fvs::Error on failure.
 void CreateDirectories(const std::string& path);
 

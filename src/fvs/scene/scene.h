@@ -32,7 +32,6 @@ struct SceneLoadOptions {
   // Reuse / write the source depth cache under W/fvs/depth/.
   bool use_depth_cache = true;
   int num_threads = 0;  // <= 0: DefaultNumThreads()
-  bool show_progress = true;
 };
 
 class Scene {

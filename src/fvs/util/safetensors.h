@@ -1,14 +1,17 @@
-// The safetensors container (https://github.com/huggingface/safetensors), read and written
-// without any tensor library so that every stage (weights, the packed training set) can use it:
+// The safetensors container (https://github.com/huggingface/safetensors), read and
+// written without any tensor library so that every stage (weights, the packed training
+// set) can use it:
 //
 //   8 bytes   N, unsigned little-endian: length of the header
-//   N bytes   JSON: {"<name>": {"dtype": "F32", "shape": [2, 3], "data_offsets": [b, e]}, ...,
-//             "__metadata__": {"key": "string value", ...}}   (padded with spaces)
+//   N bytes   JSON: {"<name>": {"dtype": "F32", "shape": [2, 3],
+//                               "data_offsets": [b, e]}, ...,
+//                    "__metadata__": {"key": "string value", ...}}   (space-padded)
 //   rest      the byte buffer; tensor data is raw little-endian, row-major, at [b, e)
 //
-// The reader checks everything against the file size before trusting it: offsets inside the
-// buffer, byte counts equal to shape x dtype size, no overlap and no hole (as the reference
-// implementation requires), known dtypes. Every problem is one fvs::Error naming the file.
+// The reader checks everything against the file size before trusting it: offsets inside
+// the buffer, byte counts equal to shape x dtype size, no overlap and no hole (as the
+// reference implementation requires), known dtypes. Every problem is one fvs::Error
+// naming the file.
 #pragma once
 
 #include <cstddef>
@@ -37,12 +40,13 @@ struct SafeTensor {
   // Convenience for fp32 data (copies the floats in/out; the dtype must be F32 to read).
   static SafeTensor FromFloats(const std::string& name, const std::vector<int64_t>& shape,
                                const float* values);
-  // Any floating dtype (F64, F32, F16, BF16) converted to float; throws fvs::Error otherwise.
+  // Any floating dtype (F64, F32, F16, BF16) converted to float; throws fvs::Error
+  // otherwise.
   std::vector<float> ToFloats() const;
 };
 
 struct SafeTensorsFile {
-  std::vector<SafeTensor> tensors;             // in the order of their data in the buffer
+  std::vector<SafeTensor> tensors;  // in the order of their data in the buffer
   std::map<std::string, std::string> metadata;  // "__metadata__": string -> string only
 
   const SafeTensor* Find(const std::string& name) const;
@@ -54,14 +58,16 @@ struct SafeTensorsFile {
 SafeTensorsFile ParseSafeTensors(const std::string& bytes, const std::string& subject);
 SafeTensorsFile ReadSafeTensors(const std::string& path);
 
-// The file's bytes: tensors sorted by name, header padded with spaces to a multiple of 8 so
-// that the data of every tensor starts 8-byte aligned (as the Python writer does). Throws
-// fvs::Error for duplicate names, a name "__metadata__", or data whose size does not match.
+// The file's bytes: tensors sorted by name, header padded with spaces to a multiple of 8
+// so that the data of every tensor starts 8-byte aligned (as the Python writer does).
+// Throws fvs::Error for duplicate names, a name "__metadata__", or data whose size does
+// not match.
 std::string SerializeSafeTensors(const SafeTensorsFile& file);
 // Atomic (temp file + rename).
 void WriteSafeTensors(const std::string& path, const SafeTensorsFile& file);
 
-// IEEE half and bfloat16 conversions (round to nearest even; overflow -> +/-inf for half).
+// IEEE half and bfloat16 conversions (round to nearest even; overflow -> +/-inf for
+// half).
 uint16_t FloatToHalf(float value);
 float HalfToFloat(uint16_t bits);
 uint16_t FloatToBFloat16(float value);
