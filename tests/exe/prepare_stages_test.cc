@@ -1,0 +1,99 @@
+#include "fvs/exe/prepare_stages.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "colmap_ext/reconstruction.h"
+#include "colmap_ext/sparse_io.h"
+#include "fvs/util/error.h"
+#include "support/test_support.h"
+
+namespace fvs {
+namespace {
+
+TEST(PrepareStages, RecognisesVideoFrames) {
+  std::vector<std::string> frames, photos;
+  for (int i = 0; i < 40; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%05d.jpg", i + 7);
+    frames.push_back(name);
+  }
+  EXPECT_TRUE(LooksLikeVideoFrames(frames));
+  photos = {"IMG_1001.JPG", "IMG_1007.JPG", "IMG_1013.JPG", "IMG_1020.JPG",
+            "IMG_1031.JPG", "IMG_1040.JPG", "IMG_1047.JPG", "IMG_1052.JPG",
+            "IMG_1060.JPG", "IMG_1077.JPG", "IMG_1079.JPG"};
+  EXPECT_FALSE(LooksLikeVideoFrames(photos));  // numbered, not consecutive
+  EXPECT_FALSE(LooksLikeVideoFrames({"a.jpg", "b.jpg"}));
+  std::vector<std::string> mixed = frames;
+  mixed[3] = "castle.jpg";
+  EXPECT_FALSE(LooksLikeVideoFrames(mixed));
+}
+
+TEST(PrepareStages, HoldoutListFromCommasOrFile) {
+  EXPECT_TRUE(ParseHoldoutList("").empty());
+  EXPECT_EQ(ParseHoldoutList("a.jpg, b.jpg,,"), (std::set<std::string>{"a.jpg", "b.jpg"}));
+  testing::TempDir dir;
+  testing::WriteTextFile(dir / "list.txt", "# targets\nx.png\n\n  y.png  \n");
+  EXPECT_EQ(ParseHoldoutList(dir / "list.txt"), (std::set<std::string>{"x.png", "y.png"}));
+}
+
+TEST(PrepareStages, ListImageFilesRejectsEmptyAndMissingFolders) {
+  testing::TempDir dir;
+  EXPECT_THROW(ListImageFiles(dir / "missing"), Error);
+  EXPECT_THROW(ListImageFiles(dir.path()), Error);
+  testing::WriteTextFile(dir / "b.PNG", "");
+  testing::WriteTextFile(dir / "a.jpg", "");
+  testing::WriteTextFile(dir / "notes.txt", "");
+  EXPECT_EQ(ListImageFiles(dir.path()), (std::vector<std::string>{"a.jpg", "b.PNG"}));
+}
+
+// Three images seeing common points; "c" held out: it must appear nowhere in the configs.
+TEST(PrepareStages, StereoConfigsKeepHoldoutsOutOfTheGeometry) {
+  testing::TempDir dir;
+  colmap::Reconstruction rec;
+  colmap::Camera camera;
+  camera.camera_id = 1;
+  camera.model_id = 1;  // PINHOLE
+  camera.width = 100;
+  camera.height = 80;
+  camera.params = {90, 90, 50, 40};
+  rec.cameras[1] = camera;
+  const char* names[] = {"a.png", "b.png", "c.png", "d.png"};
+  for (uint32_t id = 1; id <= 4; ++id) {
+    colmap::Image image;
+    image.image_id = id;
+    image.camera_id = 1;
+    image.name = names[id - 1];
+    image.tvec = Eigen::Vector3d(0.1 * id, 0, 0);
+    for (int p = 0; p < 10; ++p) {
+      colmap::Point2D pt;
+      pt.xy = Eigen::Vector2d(10 + p, 10);
+      pt.point3D_id = p + 1;
+      image.points2D.push_back(pt);
+    }
+    rec.images[id] = image;
+  }
+  for (uint64_t p = 1; p <= 10; ++p) {
+    colmap::Point3D point;
+    point.xyz = Eigen::Vector3d(0.1 * p, 0, 5);
+    // a, b, c see every point; d sees only the first three.
+    for (uint32_t id = 1; id <= 4; ++id) {
+      if (id == 4 && p > 3) continue;
+      point.track.push_back({id, static_cast<uint32_t>(p - 1)});
+    }
+    rec.points3D[p] = point;
+  }
+  colmap::WriteSparseModelBinary(dir / "sparse", rec);
+  WriteStereoConfigs(dir.path(), {"c.png"});
+  const std::string patch_match = testing::ReadTextFile(dir / "stereo/patch-match.cfg");
+  const std::string fusion = testing::ReadTextFile(dir / "stereo/fusion.cfg");
+  EXPECT_EQ(patch_match.find("c.png"), std::string::npos) << patch_match;
+  EXPECT_EQ(fusion.find("c.png"), std::string::npos) << fusion;
+  EXPECT_EQ(fusion, "a.png\nb.png\nd.png\n");
+  // Sources ranked by shared points: for a, b (10 shared) before d (3 shared).
+  EXPECT_NE(patch_match.find("a.png\nb.png, d.png\n"), std::string::npos) << patch_match;
+}
+
+}  // namespace
+}  // namespace fvs
