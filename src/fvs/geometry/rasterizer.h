@@ -2,6 +2,17 @@
 // a triangle mesh seen by a pinhole camera. Vertices are moved into the camera frame in
 // double precision first, so a scene far from the origin renders as one at the origin.
 // Triangles crossing the near plane are clipped. Pixel centres at (x + 0.5, y + 0.5).
+//
+// Behaviour worth knowing (tested in tests/geometry/rasterizer_test.cc):
+// - Depth is the exact camera-frame z of the face's plane at the pixel centre (relative
+//   error ~1e-7 against RayCastDepth); coverage uses 1/32768-px fixed point with a
+//   top-left rule, so faces sharing an edge leave no crack and never both cover a pixel.
+// - Faces with a non-finite vertex are skipped; zero-area faces cover nothing; a face
+//   index out of range throws fvs::Error. Ties in depth go to the lower face index, so
+//   the result does not depend on num_threads.
+// - Colours are perspective-correct (barycentrics of the ray's hit on the face).
+// - Images up to 16384 pixels on a side. Each calling thread keeps its scratch buffers
+//   (a few MB) for the next call.
 #pragma once
 
 #include <cstdint>
@@ -30,8 +41,10 @@ struct RasterResult {
 RasterResult Rasterize(const TriangleMesh& mesh, const PinholeCamera& camera,
                        const RasterizeOptions& options = {});
 
-// Reference: depth by casting one ray per pixel centre through every triangle (slow, exact;
-// for tests and the benchmark's accuracy figure). Optionally restricted to rows [y0, y1).
+// Reference: depth by casting one ray per pixel centre through every triangle (slow,
+// exact; for tests and the benchmark's accuracy figure). Optionally restricted to rows
+// [y0, y1) (other rows are 0). Uses a BVH built per call (about 1 s per 1 M faces); hits
+// at any depth > 0 count, faces with a non-finite vertex are skipped, no culling.
 Image RayCastDepth(const TriangleMesh& mesh, const PinholeCamera& camera, int y0 = 0,
                    int y1 = -1);
 
