@@ -1,0 +1,153 @@
+#include "fvs/net/model_config.h"
+
+#include <nlohmann/json.hpp>
+
+#include "fvs/util/error.h"
+
+namespace fvs {
+namespace {
+
+const char kSubject[] = "model config";
+
+std::string JoinNames(const std::vector<std::string>& names) {
+  std::string s;
+  for (size_t i = 0; i < names.size(); ++i) s += (i ? ", " : "") + names[i];
+  return s;
+}
+
+template <typename T>
+void Read(const nlohmann::json& json, const char* key, T* value) {
+  if (!json.contains(key)) return;
+  try {
+    *value = json.at(key).get<T>();
+  } catch (const nlohmann::json::exception&) {
+    throw Error(kSubject, std::string("field \"") + key +
+                              "\" has the wrong type: " + json.at(key).dump());
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> ModelConfig::KnownVariants() {
+  return {"fvs", "fvs_nogru", "fvs_nomasks", "fvs_noinfdepth", "fvs_single", "fvs_fast"};
+}
+
+ModelConfig ModelConfig::ForVariant(const std::string& name) {
+  ModelConfig c;
+  c.variant = name;
+  if (name == "fvs") {
+  } else if (name == "fvs_nogru") {
+    c.use_gru = false;
+  } else if (name == "fvs_nomasks") {
+    c.use_masks = false;
+  } else if (name == "fvs_noinfdepth") {
+    c.inf_depth = false;
+  } else if (name == "fvs_single") {
+    c.soft_argmax = false;
+  } else if (name == "fvs_fast") {
+    // For CPUs, about 12x fewer FLOPs than fvs per source: 32 feature channels, one conv
+    // less in the encoder's first two stages, a blending U-Net of quarter widths
+    // (16/32/64/128) with two convs per stage (conv + ConvGRU). Still recurrent with
+    // per-source confidences. Dense convs on purpose: LibTorch 1.13's CPU depthwise convs
+    // are slow (measured on 2 cores: a depthwise-separable variant of 4 GFLOPs encoded
+    // in 5.2 s, the 125 GFLOPs dense encoder in 8.8 s); depthwise_separable stays
+    // available for GPUs.
+    c.feature_channels = 32;
+    c.encoder_channels = {32, 64, 128};
+    c.encoder_convs = {1, 1, 2};
+    c.blend_channels = {16, 32, 64, 128};
+    c.blend_convs_per_stage = 2;
+    c.depthwise_separable = false;
+  } else {
+    throw Error(kSubject, "unknown network variant '" + name +
+                              "' (known: " + JoinNames(KnownVariants()) + ")");
+  }
+  return c;
+}
+
+std::string ModelConfig::ToJson() const {
+  nlohmann::ordered_json j;
+  j["variant"] = variant;
+  j["feature_channels"] = feature_channels;
+  j["use_masks"] = use_masks;
+  j["use_gru"] = use_gru;
+  j["soft_argmax"] = soft_argmax;
+  j["inf_depth"] = inf_depth;
+  j["encoder_channels"] = encoder_channels;
+  j["encoder_convs"] = encoder_convs;
+  j["blend_channels"] = blend_channels;
+  j["blend_convs_per_stage"] = blend_convs_per_stage;
+  j["depthwise_separable"] = depthwise_separable;
+  return j.dump();
+}
+
+ModelConfig ModelConfig::FromJson(const std::string& text) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(kSubject, std::string("not valid JSON: ") + e.what());
+  }
+  if (!j.is_object()) throw Error(kSubject, "not a JSON object");
+  if (!j.contains("variant") || !j["variant"].is_string()) {
+    throw Error(kSubject, "no \"variant\" string");
+  }
+  // A misspelt field would silently build the default network: refuse it.
+  static const char* const kFields[] = {"variant",
+                                        "feature_channels",
+                                        "use_masks",
+                                        "use_gru",
+                                        "soft_argmax",
+                                        "inf_depth",
+                                        "encoder_channels",
+                                        "encoder_convs",
+                                        "blend_channels",
+                                        "blend_convs_per_stage",
+                                        "depthwise_separable"};
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    bool known = false;
+    for (const char* field : kFields) known = known || it.key() == field;
+    if (!known) throw Error(kSubject, "unknown field \"" + it.key() + "\"");
+  }
+  ModelConfig c = ForVariant(j["variant"].get<std::string>());
+  Read(j, "feature_channels", &c.feature_channels);
+  Read(j, "use_masks", &c.use_masks);
+  Read(j, "use_gru", &c.use_gru);
+  Read(j, "soft_argmax", &c.soft_argmax);
+  Read(j, "inf_depth", &c.inf_depth);
+  Read(j, "encoder_channels", &c.encoder_channels);
+  Read(j, "encoder_convs", &c.encoder_convs);
+  Read(j, "blend_channels", &c.blend_channels);
+  Read(j, "blend_convs_per_stage", &c.blend_convs_per_stage);
+  Read(j, "depthwise_separable", &c.depthwise_separable);
+  c.Check();
+  return c;
+}
+
+void ModelConfig::Check() const {
+  auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw Error(kSubject, what);
+  };
+  constexpr int kMaxChannels = 4096;
+  require(feature_channels >= 1 && feature_channels <= kMaxChannels,
+          "feature_channels must be in [1, 4096]");
+  require(encoder_channels.size() >= 2 && encoder_channels.size() <= 6,
+          "encoder_channels needs 2 to 6 stages");
+  require(encoder_convs.size() == encoder_channels.size(),
+          "encoder_convs needs one count per encoder stage");
+  for (size_t i = 0; i < encoder_channels.size(); ++i) {
+    require(encoder_channels[i] >= 1 && encoder_channels[i] <= kMaxChannels,
+            "encoder_channels must be in [1, 4096]");
+    require(encoder_convs[i] >= 1 && encoder_convs[i] <= 8,
+            "encoder_convs must be in [1, 8]");
+  }
+  require(blend_channels.size() >= 2 && blend_channels.size() <= 6,
+          "blend_channels needs 2 to 6 levels");
+  for (int c : blend_channels) {
+    require(c >= 1 && c <= kMaxChannels, "blend_channels must be in [1, 4096]");
+  }
+  require(blend_convs_per_stage >= 1 && blend_convs_per_stage <= 8,
+          "blend_convs_per_stage must be in [1, 8]");
+}
+
+}  // namespace fvs

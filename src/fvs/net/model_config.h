@@ -1,0 +1,57 @@
+// What network a set of weights belongs to: the variant name and the few numbers that fix
+// its layout. Stored as JSON in the weights' __metadata__ ("fvs_config") so that a file
+// always says what it is. No torch here: the renderer and the commands read configs
+// without LibTorch.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace fvs {
+
+struct ModelConfig {
+  // fvs | fvs_nogru | fvs_nomasks | fvs_noinfdepth | fvs_single | fvs_fast
+  std::string variant = "fvs";
+  // Encoder output = warped feature channels per source.
+  int feature_channels = 64;
+  // Valid-depth and valid-warp masks appended to the warped features (66 channels in).
+  bool use_masks = true;
+  // Last conv of every blending stage is a ConvGRU whose state carries across sources.
+  bool use_gru = true;
+  // Per-source RGB + confidence, softmax over sources. false: one RGB head on the final
+  // state.
+  bool soft_argmax = true;
+  // Invalid target depth becomes 1e9 ("far away") in the renderer; false: stays
+  // 0/invalid.
+  bool inf_depth = true;
+  // Encoder: VGG16 stage widths and conv counts (stages 1-3); decoder mirrors the widths.
+  std::vector<int> encoder_channels = {64, 128, 256};
+  std::vector<int> encoder_convs = {2, 2, 3};
+  // Blending U-Net: widths of the encoder levels (the decoder mirrors all but the
+  // deepest).
+  std::vector<int> blend_channels = {64, 128, 256, 512};
+  // 3x3 convs per blending stage, the last of which is the ConvGRU when use_gru.
+  int blend_convs_per_stage = 3;
+  // Depthwise 3x3 + pointwise 1x1 instead of dense 3x3 convs (the CPU variant).
+  bool depthwise_separable = false;
+
+  // Throws fvs::Error for an unknown name, listing the known ones.
+  static ModelConfig ForVariant(const std::string& name);
+  static std::vector<std::string> KnownVariants();
+
+  std::string ToJson() const;
+  // Starts from ForVariant(json["variant"]) and overrides the fields present; throws
+  // fvs::Error("model config", ...) on bad JSON, wrong types or impossible values.
+  static ModelConfig FromJson(const std::string& json);
+
+  // Throws fvs::Error("model config", ...) when the numbers cannot make a network.
+  void Check() const;
+
+  // Input channels of the blending net per source.
+  int BlendInputChannels() const { return feature_channels + (use_masks ? 2 : 0); }
+  // Input sizes are padded to a multiple of these (total down-sampling of the U-Nets).
+  int EncoderStride() const { return 1 << (encoder_channels.size() - 1); }
+  int BlendStride() const { return 1 << (blend_channels.size() - 1); }
+};
+
+}  // namespace fvs
