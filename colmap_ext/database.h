@@ -3,6 +3,7 @@
 // unexpected.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -16,6 +17,11 @@ struct DatabaseImage {
   std::string name;
   uint32_t camera_id = 0;
   int num_keypoints = 0;
+  // Pose prior (COLMAP 3.8's prior_qw..prior_tz columns, world -> camera); only when all
+  // seven are present and finite (COLMAP leaves them NULL when unknown).
+  bool has_prior_pose = false;
+  Eigen::Vector4d prior_qvec = Eigen::Vector4d(1, 0, 0, 0);
+  Eigen::Vector3d prior_tvec = Eigen::Vector3d::Zero();
 };
 
 struct DatabaseContents {

@@ -1,0 +1,133 @@
+// Image files through OpenImageIO. Writes go to a temporary name that keeps the extension
+// (OIIO picks the format from it) and are renamed into place.
+#include "colmap_ext/image_io.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "fvs/util/atomic_file.h"
+#include "fvs/util/error.h"
+
+namespace fvs::colmap {
+namespace {
+
+namespace OIIO = OIIO_NAMESPACE;
+
+std::unique_ptr<OIIO::ImageInput> OpenInput(const std::string& path) {
+  auto input = OIIO::ImageInput::open(path);
+  if (!input) {
+    std::string message = OIIO::geterror();
+    if (message.empty()) message = "cannot open image";
+    throw Error(path, "cannot read image (" + message + ")");
+  }
+  return input;
+}
+
+std::string Extension(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot + 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  return ext;
+}
+
+}  // namespace
+
+fvs::Image ReadImage(const std::string& path, int channels) {
+  if (channels != 0 && channels != 1 && channels != 3) {
+    throw Error(path, "ReadImage: channels must be 0, 1 or 3");
+  }
+  auto input = OpenInput(path);
+  const OIIO::ImageSpec& spec = input->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1) {
+    throw Error(path, "unsupported image (empty, or a volume)");
+  }
+  Image file(spec.width, spec.height, spec.nchannels);
+  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,
+                         file.data.data())) {
+    throw Error(path, "cannot decode image (" + input->geterror() + ")");
+  }
+  input->close();
+  for (float& v : file.data) {
+    if (!std::isfinite(v)) v = 0.0f;  // no NaN/Inf leaves a stage
+  }
+  const int n = spec.nchannels;
+  if (channels == 0 || channels == n) return file;
+  // Alpha is dropped; grey images are replicated to RGB; RGB to grey by Rec. 601 luma.
+  Image out(spec.width, spec.height, channels);
+  const size_t num_pixels = static_cast<size_t>(spec.width) * spec.height;
+  for (size_t i = 0; i < num_pixels; ++i) {
+    const float* src = &file.data[i * n];
+    float rgb[3];
+    if (n < 3) {
+      rgb[0] = rgb[1] = rgb[2] = src[0];
+    } else {
+      rgb[0] = src[0];
+      rgb[1] = src[1];
+      rgb[2] = src[2];
+    }
+    if (channels == 3) {
+      for (int c = 0; c < 3; ++c) out.data[i * 3 + c] = rgb[c];
+    } else {
+      out.data[i] = n < 3 ? src[0] : 0.299f * rgb[0] + 0.587f * rgb[1] + 0.114f * rgb[2];
+    }
+  }
+  return out;
+}
+
+void ReadImageSize(const std::string& path, int* width, int* height) {
+  auto input = OpenInput(path);
+  *width = input->spec().width;
+  *height = input->spec().height;
+  input->close();
+}
+
+void WriteImage(const std::string& path, const fvs::Image& image, int bits) {
+  if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
+      image.data.size() !=
+          static_cast<size_t>(image.width) * image.height * image.channels) {
+    throw Error(path, "cannot write an empty or inconsistent image");
+  }
+  const std::string ext = Extension(path);
+  if (ext.empty())
+    throw Error(path, "image file name needs an extension (.png, .jpg, ...)");
+  OIIO::TypeDesc type = OIIO::TypeDesc::UINT8;
+  bool clamp = true;
+  if (bits == 16 && (ext == "png" || ext == "tif" || ext == "tiff")) {
+    type = OIIO::TypeDesc::UINT16;
+  } else if (bits == 32 && (ext == "exr" || ext == "tif" || ext == "tiff")) {
+    type = OIIO::TypeDesc::FLOAT;
+    clamp = false;
+  } else if (bits != 8) {
+    throw Error(path,
+                "cannot write " + std::to_string(bits) + "-bit ." + ext + " images");
+  }
+  std::vector<float> pixels = image.data;
+  for (float& v : pixels) {
+    if (!std::isfinite(v)) throw Error(path, "refusing to write an image with NaN/Inf");
+    if (clamp) v = std::min(1.0f, std::max(0.0f, v));
+  }
+  // The temporary name keeps the extension: OIIO chooses the format from it.
+  const std::string temp = TempPathFor(path) + "." + ext;
+  auto output = OIIO::ImageOutput::create(temp);
+  if (!output)
+    throw Error(path, "no image writer for ." + ext + " (" + OIIO::geterror() + ")");
+  OIIO::ImageSpec spec(image.width, image.height, image.channels, type);
+  if (ext == "jpg" || ext == "jpeg") spec.attribute("CompressionQuality", 95);
+  bool ok = output->open(temp, spec);
+  // OIIO converts float to the file's integer type by rounding to nearest.
+  ok = ok && output->write_image(OIIO::TypeDesc::FLOAT, pixels.data());
+  ok = output->close() && ok;
+  if (!ok) {
+    const std::string message = output->geterror();
+    std::remove(temp.c_str());
+    throw Error(path, "cannot write image (" + message + ")");
+  }
+  CommitTempFile(temp, path);
+}
+
+}  // namespace fvs::colmap

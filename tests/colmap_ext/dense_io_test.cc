@@ -1,0 +1,207 @@
+// Depth/normal maps (.bin), fused.ply.vis, image files and dense-workspace checks.
+#include "colmap_ext/dense_io.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+
+#include "colmap_ext/image_io.h"
+#include "colmap_ext/reconstruction.h"
+#include "colmap_ext/workspace.h"
+#include "fvs/util/error.h"
+#include "support/test_support.h"
+
+namespace fvs::colmap {
+namespace {
+
+using fvs::testing::ReadTextFile;
+using fvs::testing::TempDir;
+using fvs::testing::WriteTextFile;
+
+template <typename Fn>
+void ExpectError(Fn fn, const std::vector<std::string>& parts) {
+  try {
+    fn();
+    ADD_FAILURE() << "no error thrown";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    for (const std::string& part : parts) {
+      EXPECT_NE(message.find(part), std::string::npos) << message << " lacks " << part;
+    }
+  }
+}
+
+std::string Float32LE(const std::vector<float>& values) {
+  std::string bytes(values.size() * 4, '\0');
+  std::memcpy(bytes.data(), values.data(),
+              bytes.size());  // the test host is little-endian
+  return bytes;
+}
+
+TEST(DenseIo, ColmapArrayLayoutIsChannelPlanar) {
+  TempDir dir;
+  // 3x2 normal map: channel c of pixel (x, y) = 100 c + 10 y + x.
+  fvs::Image normals(3, 2, 3);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 3; ++x)
+      for (int c = 0; c < 3; ++c) normals.at(x, y, c) = 100.0f * c + 10.0f * y + x;
+  WriteColmapArray(dir / "n.bin", normals);
+  std::vector<float> planar;
+  for (int c = 0; c < 3; ++c)
+    for (int y = 0; y < 2; ++y)
+      for (int x = 0; x < 3; ++x) planar.push_back(100.0f * c + 10.0f * y + x);
+  EXPECT_EQ(ReadTextFile(dir / "n.bin"), "3&2&3&" + Float32LE(planar));
+  const fvs::Image back = ReadColmapArray(dir / "n.bin");
+  EXPECT_EQ(back.width, 3);
+  EXPECT_EQ(back.height, 2);
+  EXPECT_EQ(back.channels, 3);
+  EXPECT_EQ(back.data, normals.data);
+}
+
+TEST(DenseIo, DepthMapRoundTripIsExact) {
+  TempDir dir;
+  fvs::Image depth(17, 9, 1);
+  for (size_t i = 0; i < depth.data.size(); ++i)
+    depth.data[i] = (i % 5 == 0) ? 0.0f : 1.0f / (i + 3);
+  WriteColmapArray(dir / "d.bin", depth);
+  EXPECT_EQ(ReadColmapArray(dir / "d.bin").data, depth.data);
+}
+
+TEST(DenseIo, BadMapsAreNamed) {
+  TempDir dir;
+  const std::string path = dir / "d.bin";
+  const std::string body = Float32LE(std::vector<float>(6, 1.0f));
+  WriteTextFile(path, "3&2&1&" + body.substr(0, 20));
+  ExpectError([&] { ReadColmapArray(path); }, {path, "truncated", "3x2x1"});
+  WriteTextFile(path, "3&2&1&" + body + "xx");
+  ExpectError([&] { ReadColmapArray(path); }, {path, "corrupt"});
+  WriteTextFile(path, "PLY\nformat");
+  ExpectError([&] { ReadColmapArray(path); }, {path, "bad header"});
+  WriteTextFile(path, "3&2&");
+  ExpectError([&] { ReadColmapArray(path); }, {path, "bad header"});
+  WriteTextFile(path, "99999999999&2&1&");
+  ExpectError([&] { ReadColmapArray(path); }, {path, "bad header"});
+  WriteTextFile(path, "0&2&1&");
+  ExpectError([&] { ReadColmapArray(path); }, {path, "zero"});
+  std::vector<float> with_nan(6, 1.0f);
+  with_nan[4] = std::numeric_limits<float>::quiet_NaN();
+  WriteTextFile(path, "3&2&1&" + Float32LE(with_nan));
+  ExpectError([&] { ReadColmapArray(path); }, {path, "non-finite", "(1, 1)"});
+  ExpectError([&] { ReadColmapArray(dir / "missing.bin"); },
+              {"missing.bin", "cannot open"});
+  fvs::Image bad(2, 2, 1, 1.0f);
+  bad.data[0] = std::numeric_limits<float>::infinity();
+  ExpectError([&] { WriteColmapArray(dir / "out.bin", bad); }, {"out.bin", "NaN/Inf"});
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.bin"));
+}
+
+TEST(DenseIo, FusedVisibility) {
+  TempDir dir;
+  const std::vector<std::vector<uint32_t>> vis = {{0, 3, 7}, {}, {2}, {1, 2, 3, 4, 5}};
+  WriteFusedVisibility(dir / "fused.ply.vis", vis);
+  const std::string bytes = ReadTextFile(dir / "fused.ply.vis");
+  EXPECT_EQ(bytes.size(), 8u + 4 * 4 + 4 * 9);
+  uint64_t count;
+  std::memcpy(&count, bytes.data(), 8);
+  EXPECT_EQ(count, 4u);
+  EXPECT_EQ(ReadFusedVisibility(dir / "fused.ply.vis"), vis);
+  WriteTextFile(dir / "t.vis", bytes.substr(0, bytes.size() - 2));
+  ExpectError([&] { ReadFusedVisibility(dir / "t.vis"); }, {"t.vis", "truncated"});
+  std::string huge = bytes;
+  const uint64_t big = uint64_t(1) << 62;
+  std::memcpy(huge.data(), &big, 8);
+  WriteTextFile(dir / "h.vis", huge);
+  ExpectError([&] { ReadFusedVisibility(dir / "h.vis"); }, {"h.vis", "number of points"});
+  std::string big_inner = bytes;
+  const uint32_t many = 1u << 30;
+  std::memcpy(big_inner.data() + 8, &many, 4);
+  WriteTextFile(dir / "i.vis", big_inner);
+  ExpectError([&] { ReadFusedVisibility(dir / "i.vis"); }, {"i.vis", "visibility count"});
+}
+
+TEST(ImageIo, PngRoundTripsAndConversions) {
+  TempDir dir;
+  fvs::Image rgb(7, 5, 3);
+  for (size_t i = 0; i < rgb.data.size(); ++i) rgb.data[i] = (i % 256) / 255.0f;
+  WriteImage(dir / "a.png", rgb);
+  fvs::Image back = ReadImage(dir / "a.png");
+  ASSERT_EQ(back.channels, 3);
+  ASSERT_EQ(back.data.size(), rgb.data.size());
+  for (size_t i = 0; i < rgb.data.size(); ++i)
+    EXPECT_NEAR(back.data[i], rgb.data[i], 1e-6);
+  int w = 0, h = 0;
+  ReadImageSize(dir / "a.png", &w, &h);
+  EXPECT_EQ(w, 7);
+  EXPECT_EQ(h, 5);
+  const fvs::Image grey = ReadImage(dir / "a.png", 1);
+  EXPECT_EQ(grey.channels, 1);
+  EXPECT_NEAR(
+      grey.at(1, 0),
+      0.299f * rgb.at(1, 0, 0) + 0.587f * rgb.at(1, 0, 1) + 0.114f * rgb.at(1, 0, 2),
+      1e-5);
+  // 16 bit keeps finer steps; values are clamped to [0, 1].
+  fvs::Image fine(2, 1, 1);
+  fine.data = {1000.5f / 65535.0f, 7.0f};
+  WriteImage(dir / "b.png", fine, 16);
+  const fvs::Image fine_back = ReadImage(dir / "b.png", 0);
+  EXPECT_NEAR(fine_back.data[0], 1001.0f / 65535.0f, 1e-6);
+  EXPECT_EQ(fine_back.data[1], 1.0f);
+  const fvs::Image as_rgb = ReadImage(dir / "b.png", 3);
+  EXPECT_EQ(as_rgb.channels, 3);
+  EXPECT_EQ(as_rgb.at(1, 0, 2), 1.0f);
+  // JPEG by extension.
+  WriteImage(dir / "c.jpg", rgb);
+  EXPECT_EQ(ReadImage(dir / "c.jpg").width, 7);
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+    EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos);
+  }
+}
+
+TEST(ImageIo, BadImagesAreNamed) {
+  TempDir dir;
+  WriteTextFile(dir / "x.png", "not a png at all");
+  ExpectError([&] { ReadImage(dir / "x.png"); }, {"x.png"});
+  ExpectError([&] { ReadImage(dir / "none.png"); }, {"none.png"});
+  ExpectError([&] { WriteImage(dir / "noext", fvs::Image(2, 2, 3)); },
+              {"noext", "extension"});
+  ExpectError([&] { WriteImage(dir / "e.png", fvs::Image()); }, {"e.png", "empty"});
+  // A truncated PNG.
+  fvs::Image rgb(40, 30, 3, 0.25f);
+  WriteImage(dir / "t.png", rgb);
+  const std::string bytes = ReadTextFile(dir / "t.png");
+  WriteTextFile(dir / "t.png", bytes.substr(0, bytes.size() / 2));
+  ExpectError([&] { ReadImage(dir / "t.png"); }, {"t.png"});
+}
+
+TEST(Workspace, PathsAndChecks) {
+  TempDir dir;
+  const DenseWorkspace ws(dir / "w");
+  EXPECT_EQ(ws.DepthMapPath("a/b.jpg", "geometric"),
+            dir / "w/stereo/depth_maps/a/b.jpg.geometric.bin");
+  ExpectError([&] { CheckDenseWorkspace(ws); }, {"w", "does not exist"});
+  CreateDirectories(ws.ImagesDir());
+  ExpectError([&] { CheckDenseWorkspace(ws); }, {"no sparse model"});
+  CreateDirectories(ws.SparseDir());
+  WriteTextFile(ws.SparseDir() + "/cameras.bin", "");
+  WriteTextFile(ws.SparseDir() + "/images.bin", "");
+  EXPECT_NO_THROW(CheckDenseWorkspace(ws));
+  Reconstruction model;
+  colmap::Image image;  // the sparse model's image
+  image.image_id = 4;
+  image.name = "sub/a.png";
+  model.images[4] = image;
+  ExpectError([&] { CheckWorkspaceImages(ws, model); },
+              {dir / "w/images/sub/a.png", "image 4", "missing"});
+  CreateDirectories(ws.ImagesDir() + "/sub");
+  WriteTextFile(ws.ImagePath("sub/a.png"), "");
+  EXPECT_NO_THROW(CheckWorkspaceImages(ws, model));
+  WriteTextFile(dir / "file", "x");
+  ExpectError([&] { CreateDirectories(dir / "file/sub"); },
+              {"file/sub", "cannot create"});
+}
+
+}  // namespace
+}  // namespace fvs::colmap
