@@ -1,11 +1,12 @@
-// A prepared scene: the registered (undistorted, pinhole) cameras of a COLMAP dense workspace,
-// the proxy mesh, the depth of every source view rendered from that mesh, and the source
-// photos (loaded lazily).
+// A prepared scene: the registered (undistorted, pinhole) cameras of a COLMAP dense
+// workspace, the proxy mesh, the depth of every source view rendered from that mesh, and
+// the source photos (loaded lazily).
 //
 // Everything is held in scene-centred coordinates: the mean camera centre (double) is
 // subtracted from the mesh vertices and the camera translations on load, so that a scene
-// 10 km from the origin is processed exactly as one at the origin. origin() gives the offset
-// (world = scene + origin); ToSceneCamera / ToWorldCamera move cameras between the frames.
+// 10 km from the origin is processed exactly as one at the origin. origin() gives the
+// offset (world = scene + origin); ToSceneCamera / ToWorldCamera move cameras between the
+// frames.
 #pragma once
 
 #include <Eigen/Core>
@@ -36,9 +37,11 @@ struct SceneLoadOptions {
 
 class Scene {
  public:
-  // Loads W/sparse (via ReadSparseModel), W/meshed-delaunay.ply, and the source depth cache
-  // (computing what is missing or stale). Throws fvs::Error naming what is missing or bad.
-  static Scene Load(const std::string& workspace_path, const SceneLoadOptions& options = {});
+  // Loads W/sparse (via ReadSparseModel), W/meshed-delaunay.ply, and the source depth
+  // cache (computing what is missing or stale). Throws fvs::Error naming what is missing
+  // or bad.
+  static Scene Load(const std::string& workspace_path,
+                    const SceneLoadOptions& options = {});
 
   // An in-memory scene (tests, generated scenes): cameras and mesh in world coordinates;
   // they are centred here and the source depths rendered from the mesh.
@@ -64,8 +67,8 @@ class Scene {
   // Depth of source view i rendered from the mesh (1 channel, 0 = no surface), at the
   // view's resolution.
   const Image& SourceDepth(int i) const { return *source_depths_.at(i); }
-  // The photo of view i, RGB in [0, 1], read on first use (thread-safe). Throws fvs::Error
-  // if the file is missing or its size differs from the camera's.
+  // The photo of view i, RGB in [0, 1], read on first use (thread-safe). Throws
+  // fvs::Error if the file is missing or its size differs from the camera's.
   const Image& SourceImage(int i) const;
   // For in-memory scenes: sets the photo of view i (size must match the camera).
   void SetSourceImage(int i, Image image);

@@ -1,0 +1,130 @@
+// Render benchmark: time per frame with its split (target depth, source selection, warp,
+// blend) and the PSNR of the same frames against the exact ground truth, for `ulr` and
+// `nearest` at 480x270 and 960x540 with K = 1..8, on a generated scene (synthetic room,
+// exact mesh as the proxy). Held-out views are rendered from the other views.
+//   render_benchmark [--views N] [--frames F] [--max_k K] [--sizes 480x270,960x540]
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fvs/render/method.h"
+#include "fvs/scene/scene.h"
+#include "fvs/synthetic/render.h"
+#include "fvs/synthetic/synthetic_scene.h"
+#include "fvs/util/parallel.h"
+#include "fvs/util/progress.h"
+
+namespace {
+
+std::string CpuModel() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  }
+  return "unknown";
+}
+
+double Psnr(const fvs::Image& a, const fvs::Image& b) {
+  double se = 0;
+  for (size_t i = 0; i < a.data.size(); ++i) {
+    const double d = a.data[i] - b.data[i];
+    se += d * d;
+  }
+  const double mse = se / std::max<size_t>(1, a.data.size());
+  return mse > 0 ? 10 * std::log10(1.0 / mse) : 99.0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int num_views = 16, num_frames = 3, max_k = 8;
+  std::vector<std::pair<int, int>> sizes = {{480, 270}, {960, 540}};
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string a = argv[i], v = argv[i + 1];
+    if (a == "--views") num_views = std::atoi(v.c_str());
+    if (a == "--frames") num_frames = std::atoi(v.c_str());
+    if (a == "--max_k") max_k = std::atoi(v.c_str());
+    if (a == "--sizes") {
+      sizes.clear();
+      size_t p = 0;
+      while (p < v.size()) {
+        const size_t q = v.find(',', p);
+        const std::string s =
+            v.substr(p, q == std::string::npos ? std::string::npos : q - p);
+        sizes.push_back({std::atoi(s.c_str()), std::atoi(s.c_str() + s.find('x') + 1)});
+        p = q == std::string::npos ? v.size() : q + 1;
+      }
+    }
+  }
+  std::printf("machine: nproc %u, threads used %d, CPU %s\n",
+              std::thread::hardware_concurrency(), fvs::DefaultNumThreads(),
+              CpuModel().c_str());
+  std::printf(
+      "scene: synthetic room, %d views, exact mesh as proxy; %d held-out frames\n",
+      num_views, num_frames);
+  try {
+    for (const auto& [width, height] : sizes) {
+      fvs::SyntheticSceneOptions options;
+      options.num_views = num_views;
+      options.width = width;
+      options.height = height;
+      options.supersampling = 1;
+      fvs::Timer timer;
+      const fvs::SyntheticScene synthetic = fvs::BuildSyntheticScene(options);
+      std::vector<fvs::SceneView> views;
+      std::vector<fvs::Image> photos(num_views);
+      for (int i = 0; i < num_views; ++i) {
+        views.push_back({synthetic.image_names[i], static_cast<uint32_t>(i + 1), 1,
+                         synthetic.cameras[i]});
+        fvs::RenderSyntheticView(synthetic, synthetic.cameras[i], &photos[i], nullptr,
+                                 nullptr, 1);
+      }
+      fvs::Scene scene = fvs::Scene::FromWorld(views, synthetic.mesh);
+      for (int i = 0; i < num_views; ++i) scene.SetSourceImage(i, photos[i]);
+      std::printf("\n%dx%d: scene built in %.2f s (source depths %.2f s)\n", width,
+                  height, timer.Seconds(), scene.load_seconds());
+      std::printf("%-8s %2s %9s %9s %9s %9s %9s %9s %9s\n", "method", "K", "psnr_dB",
+                  "total_s", "depth_s", "select_s", "warp_s", "blend_s", "coverage");
+      for (const std::string method : {"nearest", "ulr"}) {
+        for (int k = 1; k <= max_k; ++k) {
+          if (method == "nearest" && k > 1) break;  // uses the best source only
+          fvs::RenderOptions render;
+          render.num_sources = k;
+          auto renderer = fvs::CreateMethod(method, render);
+          fvs::RenderTimings sum;
+          double psnr = 0, coverage = 0;
+          for (int f = 0; f < num_frames; ++f) {
+            const int held_out = (f + 1) * num_views / (num_frames + 1);
+            fvs::TargetView target;
+            target.name = views[held_out].name;
+            target.camera = scene.view(held_out).camera;
+            target.exclude_views = {held_out};
+            const fvs::RenderResult r = renderer->Render(scene, target);
+            psnr += Psnr(r.color, photos[held_out]) / num_frames;
+            double covered = 0;
+            for (float c : r.coverage.data) covered += c;
+            coverage += covered / r.coverage.data.size() / num_frames;
+            sum.depth_s += r.timings.depth_s / num_frames;
+            sum.selection_s += r.timings.selection_s / num_frames;
+            sum.warp_s += r.timings.warp_s / num_frames;
+            sum.blend_s += r.timings.blend_s / num_frames;
+          }
+          std::printf("%-8s %2d %9.2f %9.3f %9.3f %9.3f %9.3f %9.3f %8.1f%%\n",
+                      method.c_str(), k, psnr, sum.total(), sum.depth_s, sum.selection_s,
+                      sum.warp_s, sum.blend_s, 100 * coverage);
+          std::fflush(stdout);
+        }
+      }
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ERROR: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

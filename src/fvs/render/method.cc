@@ -1,0 +1,86 @@
+#include "fvs/render/method.h"
+
+#include <cmath>
+#include <map>
+#include <mutex>
+
+#include "fvs/render/ulr.h"
+#include "fvs/util/error.h"
+
+namespace fvs {
+
+void RenderOptions::Check() const {
+  Require(num_sources >= 1, "--num_sources", "must be at least 1");
+  Require(selection_tolerance > 0 && std::isfinite(selection_tolerance),
+          "--selection_tolerance", "must be positive");
+  Require(warp_tolerance > 0 && std::isfinite(warp_tolerance), "--warp_tolerance",
+          "must be positive");
+  Require(selection_stride >= 1, "selection_stride", "must be at least 1");
+  Require(ulr_resolution_weight >= 0 && std::isfinite(ulr_resolution_weight),
+          "ulr_resolution_weight", "must be non-negative");
+  Require(ulr_num_blend >= 1, "ulr_num_blend", "must be at least 1");
+}
+
+namespace {
+
+struct Registry {
+  std::mutex mutex;
+  std::map<std::string, MethodFactory> factories;
+};
+
+// The built-ins are registered here, not by static objects: a static archive would let
+// the linker drop an unreferenced registrar.
+Registry& GetRegistry() {
+  static Registry* registry = [] {
+    auto* r = new Registry;
+    r->factories["ulr"] = CreateUlrMethod;
+    r->factories["nearest"] = CreateNearestMethod;
+    return r;
+  }();
+  return *registry;
+}
+
+}  // namespace
+
+void RegisterMethod(const std::string& name, MethodFactory factory) {
+  Registry& registry = GetRegistry();
+  std::lock_guard<std::mutex> lock(registry.mutex);
+  registry.factories[name] = std::move(factory);
+}
+
+std::vector<std::string> RegisteredMethods() {
+  Registry& registry = GetRegistry();
+  std::lock_guard<std::mutex> lock(registry.mutex);
+  std::vector<std::string> names;
+  for (const auto& [name, factory] : registry.factories) names.push_back(name);
+  return names;
+}
+
+std::unique_ptr<Method> CreateMethod(const std::string& name,
+                                     const RenderOptions& options) {
+  MethodFactory factory;
+  {
+    Registry& registry = GetRegistry();
+    std::lock_guard<std::mutex> lock(registry.mutex);
+    const auto it = registry.factories.find(name);
+    if (it != registry.factories.end()) factory = it->second;
+  }
+  if (!factory) {
+    if (name == "fvs") {
+      if (options.model_path.empty()) {
+        throw Error("--method fvs",
+                    "method fvs needs model weights: --model_path <weights.safetensors>");
+      }
+      throw Error(
+          "--method fvs",
+          "the network is not available in this build (use --method ulr or nearest)");
+    }
+    std::string known;
+    for (const std::string& n : RegisteredMethods())
+      known += (known.empty() ? "" : ", ") + n;
+    throw Error("--method " + name, "unknown method (known: " + known + ", fvs)");
+  }
+  return factory(options);
+}
+
+}  // namespace fvs

@@ -1,0 +1,75 @@
+// Novel-view rendering methods behind one interface, chosen by name (`--method`): the
+// classical baselines `ulr` and `nearest` live here; the network (`fvs`) registers itself
+// the same way from its own library. Every method shares the geometric front end
+// (PrepareTarget in prepare.h): target depth, source selection, warping maps.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fvs/geometry/camera.h"
+#include "fvs/scene/source_selection.h"
+#include "fvs/util/image.h"
+
+namespace fvs {
+
+class Scene;
+
+// A camera to render, in the scene's (centred) frame; name is used for output files.
+struct TargetView {
+  std::string name;
+  PinholeCamera camera;
+  // Views of the scene never used as sources (e.g. the held-out view in an evaluation).
+  std::vector<int> exclude_views;
+};
+
+struct RenderOptions {
+  int num_sources = 5;                // K
+  double selection_tolerance = 0.10;  // relative depth tolerance for ranking sources
+  double warp_tolerance = 0.01;       // relative occlusion tolerance when warping
+  int selection_stride = 1;           // test every n-th target pixel when ranking
+  double ulr_resolution_weight =
+      0.2;                 // weight of the resolution penalty vs the angle (rad)
+  int ulr_num_blend = 4;   // ULR k-nearest: best sources blended per pixel
+  int num_threads = 0;     // <= 0: DefaultNumThreads()
+  std::string model_path;  // weights, for methods that need them
+  void Check() const;
+};
+
+struct RenderTimings {
+  double depth_s = 0;      // target depth from the mesh
+  double selection_s = 0;  // ranking the sources
+  double warp_s = 0;       // warping maps (+ loading the source photos)
+  double blend_s = 0;      // the method's own work
+  double total() const { return depth_s + selection_s + warp_s + blend_s; }
+};
+
+struct RenderResult {
+  Image color;       // 3 channels in [0, 1], black where no source sees the pixel
+  Image depth;       // 1 channel, target depth from the mesh (0 = no surface)
+  Image confidence;  // 1 channel in [0, 1]; 0 where not covered
+  Image coverage;    // 1 channel, 1 where at least one source contributed
+  std::vector<SourceScore> sources;  // used, best first
+  RenderTimings timings;
+};
+
+class Method {
+ public:
+  virtual ~Method() = default;
+  virtual std::string name() const = 0;
+  virtual RenderResult Render(const Scene& scene, const TargetView& target) = 0;
+};
+
+using MethodFactory = std::function<std::unique_ptr<Method>(const RenderOptions&)>;
+
+// Adds (or replaces) a method. Thread-safe.
+void RegisterMethod(const std::string& name, MethodFactory factory);
+// Names of the available methods, sorted; `ulr` and `nearest` are always there.
+std::vector<std::string> RegisteredMethods();
+// Throws fvs::Error for an unknown name, or for `fvs` when the network is not available.
+std::unique_ptr<Method> CreateMethod(const std::string& name,
+                                     const RenderOptions& options);
+
+}  // namespace fvs

@@ -1,0 +1,71 @@
+// `nearest`: the best-ranked source alone, reprojected through the target depth.
+#include <algorithm>
+#include <cmath>
+
+#include "fvs/render/prepare.h"
+#include "fvs/render/ulr.h"
+#include "fvs/scene/scene.h"
+#include "fvs/util/parallel.h"
+#include "fvs/util/progress.h"
+
+namespace fvs {
+
+namespace {
+
+class NearestMethod : public Method {
+ public:
+  explicit NearestMethod(const RenderOptions& options) : options_(options) {
+    options_.Check();
+    // Only the best source is used: warping the others would be wasted work.
+    options_.num_sources = 1;
+  }
+  std::string name() const override { return "nearest"; }
+
+  RenderResult Render(const Scene& scene, const TargetView& target) override {
+    PreparedTarget prepared = PrepareTarget(scene, target, options_);
+    RenderResult result;
+    result.timings = prepared.timings;
+    result.sources = prepared.sources;
+    Timer timer;
+    const int w = target.camera.width, h = target.camera.height;
+    result.color = Image(w, h, 3);
+    result.confidence = Image(w, h, 1);
+    result.coverage = Image(w, h, 1);
+    if (!prepared.sources.empty()) {
+      const Image& photo = scene.SourceImage(prepared.sources[0].view_index);
+      const WarpMap& warp = prepared.warps[0];
+      ParallelFor(
+          0, h,
+          [&](int64_t y) {
+            float sample[4];
+            for (int x = 0; x < w; ++x) {
+              const size_t i = static_cast<size_t>(y) * w + x;
+              if (warp.valid_warp.data[i] <= 0) continue;
+              SampleBilinear(photo, warp.source_xy.data[2 * i],
+                             warp.source_xy.data[2 * i + 1], sample, true);
+              for (int c = 0; c < 3; ++c) {
+                const float v = std::isfinite(sample[c]) ? sample[c] : 0.f;
+                result.color.data[3 * i + c] = std::clamp(v, 0.f, 1.f);
+              }
+              result.coverage.data[i] = 1.f;
+              result.confidence.data[i] = 1.f;
+            }
+          },
+          options_.num_threads);
+    }
+    result.depth = std::move(prepared.depth);
+    result.timings.blend_s = timer.Seconds();
+    return result;
+  }
+
+ private:
+  RenderOptions options_;
+};
+
+}  // namespace
+
+std::unique_ptr<Method> CreateNearestMethod(const RenderOptions& options) {
+  return std::make_unique<NearestMethod>(options);
+}
+
+}  // namespace fvs

@@ -1,0 +1,23 @@
+// The geometric front end every method shares: target depth from the proxy mesh, the
+// top-K sources by overlap, and one warping map per selected source (same target depth
+// for all).
+#pragma once
+
+#include <vector>
+
+#include "fvs/render/method.h"
+#include "fvs/scene/warp.h"
+
+namespace fvs {
+
+struct PreparedTarget {
+  Image depth;                       // target depth (0 = no surface)
+  std::vector<SourceScore> sources;  // best first, only sources that see something
+  std::vector<WarpMap> warps;        // one per source, same order
+  RenderTimings timings;             // depth_s, selection_s, warp_s filled
+};
+
+PreparedTarget PrepareTarget(const Scene& scene, const TargetView& target,
+                             const RenderOptions& options);
+
+}  // namespace fvs
