@@ -1,0 +1,80 @@
+// colmap view_synthesis_mesher --workspace_path W [--output_path W/meshed-delaunay.ply]
+//
+// The built-in Delaunay graph-cut mesher (src/fvs/mvs/delaunay.h) on a COLMAP dense
+// workspace: W/fused.ply + W/fused.ply.vis + W/sparse -> W/meshed-delaunay.ply, with the
+// options of COLMAP's delaunay_mesher (--DelaunayMeshing.*, same names and defaults), for
+// the COLMAP builds that lack CGAL (Debian's). Bad input: one error line, exit 1, no
+// output.
+#include <iostream>
+#include <string>
+
+#include "colmap_ext/workspace.h"
+#include "fvs/exe/command_registry.h"
+#include "fvs/exe/option_manager.h"
+#include "fvs/mvs/delaunay.h"
+#include "fvs/util/error.h"
+
+namespace fvs {
+namespace {
+
+int RunViewSynthesisMesher(int argc, char** argv) {
+  std::string workspace_path;
+  std::string output_path;
+  mvs::DelaunayMeshingOptions o;
+  OptionManager options(
+      "view_synthesis_mesher",
+      "Delaunay graph-cut meshing (Labatut et al. 2009, as COLMAP's delaunay_mesher) of "
+      "W/fused.ply with the visibility in W/fused.ply.vis and the cameras of W/sparse; "
+      "writes W/meshed-delaunay.ply.");
+  options.AddRequired("workspace_path", &workspace_path,
+                      "COLMAP dense workspace with fused.ply, fused.ply.vis and sparse/");
+  options.AddDefault("output_path", &output_path,
+                     "output mesh (default: <workspace_path>/meshed-delaunay.ply)");
+  options.AddDefault("DelaunayMeshing.max_proj_dist", &o.max_proj_dist,
+                     "merge points that reproject within this many pixels of a cell's "
+                     "vertices in every image that sees them (0: keep all points)");
+  options.AddDefault("DelaunayMeshing.max_depth_dist", &o.max_depth_dist,
+                     "... and whose relative depth differs by less than this");
+  options.AddDefault("DelaunayMeshing.visibility_sigma", &o.visibility_sigma,
+                     "points seen by few images weigh less: 1 - exp(-n^2 / (2 sigma^2))");
+  options.AddDefault(
+      "DelaunayMeshing.distance_sigma_factor", &o.distance_sigma_factor,
+      "free-space falloff near a point, times the 25th percentile edge length");
+  options.AddDefault("DelaunayMeshing.quality_regularization", &o.quality_regularization,
+                     "weight of the surface-quality (smoothness) term");
+  options.AddDefault("DelaunayMeshing.max_side_length_factor", &o.max_side_length_factor,
+                     "drop faces whose longest side exceeds this factor times ...");
+  options.AddDefault("DelaunayMeshing.max_side_length_percentile",
+                     &o.max_side_length_percentile,
+                     "... this percentile of the faces' longest sides");
+  options.AddDefault("DelaunayMeshing.num_threads", &o.num_threads,
+                     "threads (-1: all cores)");
+  if (!options.Parse(argc, argv)) return 0;
+  if (output_path.empty()) {
+    output_path = colmap::DenseWorkspace(workspace_path).DelaunayMeshPath();
+  }
+  o.Check();
+
+  if constexpr (!mvs::DelaunayMesherAvailable()) {
+    throw Error(
+        "colmap view_synthesis_mesher",
+        "the built-in Delaunay mesher is unavailable: this build has no CGAL or "
+        "Boost.Graph (install libcgal-dev and libboost-graph-dev and rebuild), or use "
+        "a COLMAP built with CGAL: colmap delaunay_mesher");
+  }
+#ifdef FVS_HAVE_CGAL
+  const mvs::DelaunayMeshingStats stats =
+      mvs::DenseDelaunayMeshing(workspace_path, output_path, o);
+  std::cout << "Delaunay mesher: " << stats.Summary() << "\n"
+            << "Wrote " << output_path << std::endl;
+#endif
+  return 0;
+}
+
+}  // namespace
+
+FVS_REGISTER_COMMAND("view_synthesis_mesher",
+                     "Delaunay graph-cut mesh of a dense workspace (built-in, CPU)",
+                     RunViewSynthesisMesher);
+
+}  // namespace fvs
