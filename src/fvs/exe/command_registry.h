@@ -33,5 +33,9 @@ int RunCommand(int argc, char** argv);
 
 }  // namespace fvs
 
-#define FVS_REGISTER_COMMAND(name, description, function) \
-  static ::fvs::CommandRegistrar fvs_command_registrar_##function(name, description, function)
+#define FVS_REGISTER_COMMAND_CONCAT_(a, b) a##b
+#define FVS_REGISTER_COMMAND_NAME_(line) FVS_REGISTER_COMMAND_CONCAT_(fvs_command_registrar_, line)
+// Works with qualified function names too: the registrar is named after the line.
+#define FVS_REGISTER_COMMAND(name, description, function)                 \
+  static ::fvs::CommandRegistrar FVS_REGISTER_COMMAND_NAME_(__LINE__)( \
+      name, description, function)

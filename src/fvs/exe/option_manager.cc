@@ -1,6 +1,7 @@
 #include "fvs/exe/option_manager.h"
 
 #include <cerrno>
+#include <charconv>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -80,10 +81,14 @@ std::string OptionManager::ValueString(const Option& option) const {
     case Option::Kind::kInt:
       s << *static_cast<int*>(option.target);
       break;
-    case Option::Kind::kDouble:
-      s.precision(17);
-      s << *static_cast<double*>(option.target);
+    case Option::Kind::kDouble: {
+      // Shortest text that reads back as the same double ("0.05", not 0.05000000000000001).
+      char buffer[64];
+      const auto r = std::to_chars(buffer, buffer + sizeof(buffer),
+                                   *static_cast<double*>(option.target));
+      s << std::string(buffer, r.ptr);
       break;
+    }
     case Option::Kind::kBool:
       s << (*static_cast<bool*>(option.target) ? 1 : 0);
       break;

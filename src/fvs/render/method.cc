@@ -4,6 +4,8 @@
 #include <map>
 #include <mutex>
 
+#include "fvs/net/model_config.h"
+#include "fvs/render/fvs_method.h"
 #include "fvs/render/ulr.h"
 #include "fvs/util/error.h"
 
@@ -35,6 +37,12 @@ Registry& GetRegistry() {
     auto* r = new Registry;
     r->factories["ulr"] = CreateUlrMethod;
     r->factories["nearest"] = CreateNearestMethod;
+    // The network under its generic name and under each variant name.
+    for (const std::string& variant : ModelConfig::KnownVariants()) {
+      r->factories[variant] = [variant](const RenderOptions& options) {
+        return CreateFvsMethod(variant, options);
+      };
+    }
     return r;
   }();
   return *registry;

@@ -42,8 +42,9 @@ struct RenderTimings {
   double depth_s = 0;      // target depth from the mesh
   double selection_s = 0;  // ranking the sources
   double warp_s = 0;       // warping maps (+ loading the source photos)
+  double encode_s = 0;     // encoding source features (network; 0 when cached)
   double blend_s = 0;      // the method's own work
-  double total() const { return depth_s + selection_s + warp_s + blend_s; }
+  double total() const { return depth_s + selection_s + warp_s + encode_s + blend_s; }
 };
 
 struct RenderResult {
