@@ -60,6 +60,9 @@ void Progress::Print(bool final_line) {
   const double fraction =
       std::min(1.0, static_cast<double>(done_) / static_cast<double>(total_));
   const int percent = static_cast<int>(fraction * 100.0);
+  if (final_line && !tty_ && percent == 100 && last_percent_printed_ == 100) {
+    return;  // the 100% line is already in the log
+  }
   if (!final_line) {
     if (tty_) {
       if (std::chrono::duration<double>(now - last_print_).count() < 0.1 &&
