@@ -1,0 +1,227 @@
+#include "fvs/mvs/patch_match_stereo.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <set>
+
+#include "colmap_ext/dense_io.h"
+#include "colmap_ext/image_io.h"
+#include "colmap_ext/sparse_io.h"
+#include "colmap_ext/workspace.h"
+#include "fvs/mvs/stereo_config.h"
+#include "fvs/util/error.h"
+#include "fvs/util/parallel.h"
+#include "fvs/util/progress.h"
+
+namespace fvs::mvs {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool Exists(const std::string& path) {
+  std::error_code ec;
+  return fs::is_regular_file(path, ec);
+}
+
+struct ViewSet {
+  std::vector<StereoView> views;
+  std::map<uint32_t, int> index_of;  // image id -> views index
+};
+
+}  // namespace
+
+void PatchMatchStereoOptions::Check() const {
+  patch_match.Check();
+  const std::string s = "PatchMatchStereo";
+  Require(max_image_size >= 0, s, "max_image_size must be >= 0 (0 = full size)");
+  Require(max_image_size == 0 || max_image_size >= 16, s,
+          "max_image_size must be 0 or at least 16");
+  Require(max_num_sources >= 1 && max_num_sources <= 64, s,
+          "max_num_sources must be in [1, 64]");
+  Require(min_triangulation_angle >= 0 && min_triangulation_angle < 90, s,
+          "min_triangulation_angle must be in [0, 90)");
+}
+
+PatchMatchStereoSummary RunPatchMatchStereo(const std::string& workspace_path,
+                                            const PatchMatchStereoOptions& options) {
+  options.Check();
+  Timer timer;
+  PatchMatchStereoSummary summary;
+  const colmap::DenseWorkspace ws(workspace_path);
+  colmap::CheckDenseWorkspace(ws);
+  const colmap::Reconstruction rec = colmap::ReadSparseModel(ws.SparseDir());
+  rec.Check(ws.SparseDir());
+  Require(rec.images.size() >= 2, ws.SparseDir(),
+          "stereo needs at least 2 images, the sparse model has " +
+              std::to_string(rec.images.size()));
+  WriteDefaultStereoConfigs(ws.StereoDir(), rec);
+  const std::string cfg_path = ws.StereoDir() + "/patch-match.cfg";
+  std::vector<StereoProblem> problems =
+      ReadPatchMatchConfig(cfg_path, rec, options.min_triangulation_angle);
+  Require(!problems.empty(), cfg_path, "lists no images");
+  summary.num_problems = static_cast<int>(problems.size());
+  for (StereoProblem& p : problems) {
+    if (static_cast<int>(p.source_image_ids.size()) > options.max_num_sources) {
+      p.source_image_ids.resize(options.max_num_sources);
+    }
+  }
+
+  // Every image involved, checked before any work: a missing file is one clear error.
+  std::set<uint32_t> involved;
+  for (const StereoProblem& p : problems) {
+    involved.insert(p.ref_image_id);
+    involved.insert(p.source_image_ids.begin(), p.source_image_ids.end());
+  }
+  for (uint32_t id : involved) {
+    const std::string path = ws.ImagePath(rec.images.at(id).name);
+    Require(Exists(path), path, "image file is missing (the sparse model lists it)");
+  }
+  ViewSet set;
+  set.views.resize(involved.size());
+  {
+    std::vector<uint32_t> ids(involved.begin(), involved.end());
+    for (size_t i = 0; i < ids.size(); ++i) set.index_of[ids[i]] = static_cast<int>(i);
+    ParallelFor(
+        0, static_cast<int64_t>(ids.size()),
+        [&](int64_t i) {
+          const colmap::Image& image = rec.images.at(ids[i]);
+          const std::string path = ws.ImagePath(image.name);
+          StereoView& view = set.views[i];
+          view.name = image.name;
+          PinholeCamera camera = rec.PinholeFor(image.image_id);
+          Image grey = colmap::ReadImage(path, 1);
+          Require(grey.width == camera.width && grey.height == camera.height, path,
+                  "image is " + std::to_string(grey.width) + "x" +
+                      std::to_string(grey.height) + " but its camera is " +
+                      std::to_string(camera.width) + "x" + std::to_string(camera.height));
+          const int longest = std::max(camera.width, camera.height);
+          if (options.max_image_size > 0 && longest > options.max_image_size) {
+            const double scale = static_cast<double>(options.max_image_size) / longest;
+            const int w =
+                std::max(2, static_cast<int>(std::lround(camera.width * scale)));
+            const int h =
+                std::max(2, static_cast<int>(std::lround(camera.height * scale)));
+            grey = DownscaleGrey(grey, w, h);
+            camera = camera.Resized(w, h);
+          }
+          view.camera = camera;
+          view.grey = std::move(grey);
+          if (!ComputeDepthRange(rec, image.image_id, &view.depth_min, &view.depth_max)) {
+            view.depth_min = view.depth_max = 0;
+          }
+        },
+        options.patch_match.num_threads);
+  }
+  colmap::CreateDirectories(ws.StereoDir() + "/depth_maps");
+  colmap::CreateDirectories(ws.StereoDir() + "/normal_maps");
+
+  auto sources_of = [&](const StereoProblem& p) {
+    std::vector<int> sources;
+    for (uint32_t id : p.source_image_ids) sources.push_back(set.index_of.at(id));
+    return sources;
+  };
+  auto solvable = [&](const StereoProblem& p) {
+    const StereoView& v = set.views[set.index_of.at(p.ref_image_id)];
+    return !p.source_image_ids.empty() && v.depth_max > v.depth_min && v.depth_min > 0;
+  };
+  for (const StereoProblem& p : problems) {
+    if (!solvable(p)) {
+      ++summary.num_without_depth_range;
+      std::cerr
+          << "WARNING: " << rec.images.at(p.ref_image_id).name
+          << ": no source views or no sparse points to bound its depth; no depth map"
+          << std::endl;
+    }
+  }
+
+  // Photometric pass.
+  const bool photometric_filter = !options.geom_consistency && options.patch_match.filter;
+  PatchMatchOptions photometric_options = options.patch_match;
+  photometric_options.filter = photometric_filter;
+  std::set<uint32_t> recomputed;
+  {
+    Progress progress("PatchMatch photometric", summary.num_problems);
+    for (const StereoProblem& p : problems) {
+      const std::string& name = rec.images.at(p.ref_image_id).name;
+      const std::string depth_path = ws.DepthMapPath(name, "photometric");
+      const std::string normal_path = ws.NormalMapPath(name, "photometric");
+      if (solvable(p) &&
+          (options.overwrite || !Exists(depth_path) || !Exists(normal_path))) {
+        const DepthNormalMap map =
+            PatchMatchView(set.views, set.index_of.at(p.ref_image_id), sources_of(p),
+                           photometric_options);
+        colmap::WriteColmapArray(normal_path, map.normal);
+        colmap::WriteColmapArray(depth_path, map.depth);
+        recomputed.insert(p.ref_image_id);
+        ++summary.num_photometric_computed;
+      }
+      progress.Advance();
+    }
+    progress.Finish();
+  }
+
+  // Geometric pass against the sources' photometric depth maps.
+  if (options.geom_consistency) {
+    std::map<uint32_t, Image> photometric_depths;
+    auto photometric_depth = [&](uint32_t id) -> const Image& {
+      auto it = photometric_depths.find(id);
+      if (it != photometric_depths.end()) return it->second;
+      const StereoView& view = set.views[set.index_of.at(id)];
+      const std::string path = ws.DepthMapPath(view.name, "photometric");
+      Image depth(view.camera.width, view.camera.height, 1);  // none: no consistency
+      if (Exists(path)) {
+        depth = colmap::ReadColmapArray(path);
+        Require(
+            depth.width == view.camera.width && depth.height == view.camera.height &&
+                depth.channels == 1,
+            path,
+            "depth map size differs from the working image size (computed with another "
+            "max_image_size?); rerun with --PatchMatchStereo.overwrite 1");
+      }
+      return photometric_depths.emplace(id, std::move(depth)).first->second;
+    };
+    Progress progress("PatchMatch geometric", summary.num_problems);
+    for (const StereoProblem& p : problems) {
+      const std::string& name = rec.images.at(p.ref_image_id).name;
+      const std::string depth_path = ws.DepthMapPath(name, "geometric");
+      const std::string normal_path = ws.NormalMapPath(name, "geometric");
+      bool stale = recomputed.count(p.ref_image_id) > 0;
+      for (uint32_t s : p.source_image_ids) stale = stale || recomputed.count(s) > 0;
+      const bool missing = !Exists(depth_path) || !Exists(normal_path);
+      if (solvable(p) && (options.overwrite || missing || stale)) {
+        std::vector<const Image*> source_depths;
+        for (uint32_t s : p.source_image_ids)
+          source_depths.push_back(&photometric_depth(s));
+        DepthNormalMap init;
+        init.depth = photometric_depth(p.ref_image_id);
+        init.normal = colmap::ReadColmapArray(ws.NormalMapPath(name, "photometric"));
+        Require(init.normal.width == init.depth.width &&
+                    init.normal.height == init.depth.height && init.normal.channels == 3,
+                ws.NormalMapPath(name, "photometric"),
+                "normal map does not match its depth map; rerun with "
+                "--PatchMatchStereo.overwrite 1");
+        const DepthNormalMap map =
+            PatchMatchView(set.views, set.index_of.at(p.ref_image_id), sources_of(p),
+                           options.patch_match, &source_depths, &init);
+        colmap::WriteColmapArray(normal_path, map.normal);
+        colmap::WriteColmapArray(depth_path, map.depth);
+        ++summary.num_geometric_computed;
+      } else if (solvable(p) && !recomputed.count(p.ref_image_id)) {
+        ++summary.num_skipped;
+      }
+      progress.Advance();
+    }
+    progress.Finish();
+  } else {
+    for (const StereoProblem& p : problems) {
+      if (solvable(p) && !recomputed.count(p.ref_image_id)) ++summary.num_skipped;
+    }
+  }
+  summary.seconds = timer.Seconds();
+  return summary;
+}
+
+}  // namespace fvs::mvs
