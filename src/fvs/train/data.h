@@ -1,0 +1,115 @@
+// The trainer's side of the packed training set (pack.h): loading a scene.safetensors
+// into tensors, leave-one-out source selection, the warp of a target crop into its
+// sources (grid_sample grid and masks, computed in double precision from the relative
+// poses), and the random sampler whose state a checkpoint stores. Reads only
+// util/safetensors + torch.
+#pragma once
+
+#include <torch/torch.h>
+
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace fvs {
+
+struct PackedScene {
+  std::string path;  // the folder
+  std::vector<std::string> names;
+  torch::Tensor images;   // uint8 [N,3,H,W]
+  torch::Tensor depths;   // float [N,H,W], 0 = no surface
+  torch::Tensor K, R, t;  // double [N,3,3], [N,3,3], [N,3]
+  torch::Tensor overlap;  // float [N,N], diagonal 0
+
+  int num_views() const { return static_cast<int>(names.size()); }
+  int height() const { return static_cast<int>(images.size(2)); }
+  int width() const { return static_cast<int>(images.size(3)); }
+};
+
+// Reads folder/scene.safetensors and checks every tensor (dtypes, shapes, finite values,
+// depths >= 0, overlap in [0,1]); throws fvs::Error naming the file.
+PackedScene LoadPackedScene(const std::string& folder);
+
+// Leave-one-out: the up to k views of highest overlap[target] (> 0 only), best first,
+// ties by index; never the target itself.
+std::vector<int> SelectTrainingSources(const PackedScene& scene, int target, int k);
+
+struct WarpSettings {
+  double occlusion_tolerance = 0.01;  // |z - D_source| <= tol * z
+  bool inf_depth = true;              // no-surface target pixels at invalid_depth
+  double invalid_depth = 1e9;
+};
+
+struct TrainingWarp {
+  torch::Tensor grid;         // float [K,h,w,2], grid_sample (align_corners = false)
+  torch::Tensor valid_depth;  // float [1,1,h,w]
+  torch::Tensor valid_warp;   // float [K,1,h,w]
+};
+
+// target_K/R/t: double [3,3], [3,3], [3]; target_depth float [h,w] (its camera's image
+// size); source_K/R/t: double [K,3,3], [K,3,3], [K,3]; source_depths float [K,H,W]. The
+// same conventions as fvs::ComputeWarpMap (scene/warp.h): pixel centres at +0.5; the
+// occlusion test passes with the source depth at the nearest source pixel (no surface =
+// invalid_depth) or, failing that, with the depth interpolated between the 4 nearest
+// pixel centres when all 4 are surface. Target pixels without a surface warp from
+// invalid_depth when inf_depth, else are invalid.
+TrainingWarp ComputeTrainingWarp(
+    const torch::Tensor& target_K, const torch::Tensor& target_R,
+    const torch::Tensor& target_t, const torch::Tensor& target_depth,
+    const torch::Tensor& source_K, const torch::Tensor& source_R,
+    const torch::Tensor& source_t, const torch::Tensor& source_depths,
+    const WarpSettings& settings);
+
+struct TrainingSample {
+  int scene = 0, target = 0, x0 = 0, y0 = 0;
+  std::vector<int> sources;
+  torch::Tensor target_rgb;  // float [1,3,h,w] in [0,1]
+  torch::Tensor source_rgb;  // float [K,3,H,W] in [-1,1] (the net's input range)
+  TrainingWarp warp;
+};
+
+// The sample of target view `target` cropped to [x0, x0+w) x [y0, y0+h) (intrinsics moved
+// by the crop origin), with the given sources at full size.
+TrainingSample MakeSample(const PackedScene& scene, int target,
+                          const std::vector<int>& sources, int x0, int y0, int crop_width,
+                          int crop_height, const WarpSettings& settings);
+
+// Photometric augmentation, the same for the target and all its sources so that the
+// colours stay consistent across views (no geometric change: the cameras stay valid).
+struct ColorJitter {
+  double brightness = 0;       // added, in [0,1] units
+  double contrast = 1;         // around 0.5
+  double saturation = 1;       // around the grey value
+  double gain[3] = {1, 1, 1};  // per channel (white balance)
+};
+void ApplyColorJitter(const ColorJitter& jitter, TrainingSample* sample);
+
+struct SamplerOptions {
+  int num_sources = 5;
+  int crop = 192;
+  bool augment = true;
+  WarpSettings warp;
+};
+
+// Random leave-one-out samples: a target uniformly over all views of all scenes that have
+// a source, a uniform crop, jitter when augment. Everything random comes from one
+// std::mt19937_64 whose state State() / SetState() carry through a checkpoint, so a
+// resumed run draws exactly the samples an uninterrupted run would.
+class TrainingSampler {
+ public:
+  TrainingSampler(const std::vector<PackedScene>* scenes, const SamplerOptions& options,
+                  uint64_t seed);
+  TrainingSample Next();
+  std::string State() const;
+  void SetState(const std::string& state);  // throws fvs::Error on a malformed state
+
+ private:
+  double Uniform(double lo, double hi);
+  const std::vector<PackedScene>* scenes_;
+  SamplerOptions options_;
+  std::vector<std::pair<int, int>> targets_;  // (scene, view) with at least one source
+  std::mt19937_64 rng_;
+};
+
+}  // namespace fvs

@@ -1,0 +1,69 @@
+// Options of the trainer (`colmap view_synthesis_train` and the standalone fvs_train_main
+// share them) and the entry point. No torch here: the commands include this header only.
+//
+// The option parser is a minimal COLMAP-style `--key value` parser of its own because the
+// trainer-only build (GPU machine) has no src/fvs/exe (OptionManager).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace fvs {
+
+struct TrainOptions {
+  std::string scene_list;      // file: one packed scene folder per line
+  std::string output_path;     // M/: checkpoints, validation.csv, model.safetensors
+  std::string val_scene_list;  // optional: held-out scenes for validation
+  std::string vgg19_path;      // optional: VGG19 safetensors -> L1 + perceptual loss
+  std::string variant = "fvs";
+  std::string device = "auto";  // auto | cpu | cuda
+  int max_steps = 100000;
+  int num_sources = 5;
+  int crop = 192;
+  int batch_size = 1;  // targets per optimiser step (gradients accumulated)
+  double learning_rate = 1e-4;
+  double checkpoint_minutes = 10;
+  int checkpoint_every_steps = 0;  // > 0: also every N steps (tests, reproducibility)
+  int keep_checkpoints = 2;
+  int log_every = 10;
+  int val_every = 1000;  // 0: no periodic validation (still at the end with a list)
+  int val_views = 4;     // held-out views per validation scene
+  int seed = 0;
+  bool augment = true;
+  bool fp16_weights = false;
+  double occlusion_tolerance = 0.01;  // warp validity, relative (reference: 1%)
+  int num_threads = 0;                // CPU threads for LibTorch; <= 0: default
+  bool quiet = false;                 // no progress lines (tests)
+  // Tests: replaces the variant's layout with this JSON (ModelConfig::FromJson).
+  std::string model_config_json;
+
+  // Throws fvs::Error("view_synthesis_train", ...) for impossible values.
+  void Check() const;
+};
+
+// Parses argv[first..argc): `--scene_list L`, `--Train.max_steps N`, ... (every option
+// has a `Train.` name; the path options also a bare one). Returns false when help was
+// asked for (printed to stdout). Throws fvs::Error naming an unknown option, a missing or
+// malformed value, or a missing required option.
+bool ParseTrainOptions(int argc, char** argv, int first, TrainOptions* options);
+std::string TrainUsage(const std::string& program);
+
+// Reads a scene list: one folder per line; blank lines and lines starting with '#' are
+// skipped; relative paths are relative to the list's folder. Throws fvs::Error
+// "<list>:<line>: ..." for a folder that does not exist or has no scene.safetensors, and
+// for an empty list.
+std::vector<std::string> ReadSceneList(const std::string& list_path);
+
+struct TrainSummary {
+  int steps_done = 0;        // total steps of the run (resumed ones included)
+  int resumed_from = -1;     // step of the checkpoint resumed from, -1 = fresh start
+  double final_loss = 0;     // mean loss of the last logged window
+  double seconds = 0;        // wall time of this invocation
+  bool interrupted = false;  // stopped by SIGINT/SIGTERM (checkpoint written)
+  std::string model_path;    // M/model.safetensors when max_steps was reached
+};
+
+// Trains (or resumes) as the options say. Throws fvs::Error on bad input.
+TrainSummary RunTraining(const TrainOptions& options);
+
+}  // namespace fvs

@@ -1,0 +1,383 @@
+#include "fvs/train/trainer.h"
+
+#include <torch/version.h>
+
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "fvs/util/atomic_file.h"
+#include "fvs/util/error.h"
+#include "fvs/util/parallel.h"
+#include "fvs/util/progress.h"
+#include "fvs/util/string_util.h"
+
+namespace fvs {
+namespace {
+
+volatile std::sig_atomic_t g_stop_requested = 0;
+void RequestStop(int) { g_stop_requested = 1; }
+
+// Restores the previous handlers when the loop ends (tests run several loops).
+class StopSignals {
+ public:
+  StopSignals() {
+    g_stop_requested = 0;
+    old_int_ = std::signal(SIGINT, RequestStop);
+    old_term_ = std::signal(SIGTERM, RequestStop);
+  }
+  ~StopSignals() {
+    std::signal(SIGINT, old_int_);
+    std::signal(SIGTERM, old_term_);
+  }
+
+ private:
+  void (*old_int_)(int);
+  void (*old_term_)(int);
+};
+
+std::vector<PackedScene> LoadScenes(const std::string& list, int min_views, int k) {
+  std::vector<PackedScene> scenes;
+  for (const std::string& folder : ReadSceneList(list)) {
+    PackedScene s = LoadPackedScene(folder);
+    Require(s.num_views() >= min_views, folder,
+            "has " + std::to_string(s.num_views()) + " views; training with " +
+                std::to_string(k) + " sources needs at least " +
+                std::to_string(min_views) + " (listed in " + list + ")");
+    scenes.push_back(std::move(s));
+  }
+  return scenes;
+}
+
+std::string CpuModel() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (StartsWith(line, "model name")) {
+      const size_t colon = line.find(':');
+      if (colon != std::string::npos) return TrimString(line.substr(colon + 1));
+    }
+  }
+  return "unknown CPU";
+}
+
+std::string FormatDuration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = std::lround(seconds);
+  std::ostringstream out;
+  out << s / 3600 << "h" << std::setw(2) << std::setfill('0') << (s / 60) % 60 << "m"
+      << std::setw(2) << s % 60 << "s";
+  return out.str();
+}
+
+std::string UtcNow() {
+  const std::time_t now = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  return buf;
+}
+
+struct DeviceSample {
+  torch::Tensor target, sources, grid, valid_depth, valid_warp;
+};
+DeviceSample ToDevice(const TrainingSample& s, const torch::Device& device) {
+  return {s.target_rgb.to(device), s.source_rgb.to(device), s.warp.grid.to(device),
+          s.warp.valid_depth.to(device), s.warp.valid_warp.to(device)};
+}
+
+}  // namespace
+
+Trainer::Trainer(const TrainOptions& options) : options_(options) {
+  options_.Check();
+  if (options_.num_threads > 0) {
+    torch::set_num_threads(options_.num_threads);
+  } else {
+    ConfigureTorchThreads();
+  }
+  config_ = options_.model_config_json.empty()
+                ? ModelConfig::ForVariant(options_.variant)
+                : ModelConfig::FromJson(options_.model_config_json);
+  config_.Check();
+  if (options_.device == "cuda") {
+    Require(torch::cuda::is_available(), "view_synthesis_train",
+            "--Train.device cuda, but this LibTorch sees no CUDA device");
+  }
+  device_ = (options_.device == "cuda" ||
+             (options_.device == "auto" && torch::cuda::is_available()))
+                ? torch::Device(torch::kCUDA)
+                : torch::Device(torch::kCPU);
+
+  const int k = options_.num_sources;
+  train_scenes_ = LoadScenes(options_.scene_list, k + 1, k);
+  if (!options_.val_scene_list.empty()) {
+    val_scenes_ = LoadScenes(options_.val_scene_list, 2, k);
+  }
+
+  torch::manual_seed(static_cast<uint64_t>(options_.seed));
+  net_ = FvsNet(config_);
+  net_->to(device_);
+  optimizer_ = std::make_unique<torch::optim::Adam>(
+      net_->parameters(), torch::optim::AdamOptions(options_.learning_rate));
+  SamplerOptions sampler;
+  sampler.num_sources = k;
+  sampler.crop = options_.crop;
+  sampler.augment = options_.augment;
+  sampler.warp.occlusion_tolerance = options_.occlusion_tolerance;
+  sampler.warp.inf_depth = config_.inf_depth;
+  // A seed of its own stream: the sampler must not share draws with LibTorch.
+  sampler_ = std::make_unique<TrainingSampler>(
+      &train_scenes_, sampler,
+      0x9E3779B97F4A7C15ULL ^ static_cast<uint64_t>(options_.seed));
+  loss_ = std::make_unique<TrainingLoss>(options_.vgg19_path, device_);
+  Resume();
+}
+
+LossValue Trainer::Step() {
+  net_->train();
+  optimizer_->zero_grad();
+  LossValue mean;
+  const int b = options_.batch_size;
+  for (int i = 0; i < b; ++i) {
+    const DeviceSample s = ToDevice(sampler_->Next(), device_);
+    const BlendOutput out = net_->Forward(s.sources, s.grid, s.valid_depth, s.valid_warp);
+    const torch::Tensor prediction01 = (out.rgb + 1.0) * 0.5;
+    LossValue loss = (*loss_)(prediction01, s.target);
+    Require(std::isfinite(loss.l1) && std::isfinite(loss.second), "view_synthesis_train",
+            "the loss became NaN or Inf at step " + std::to_string(step_ + 1) +
+                " (resume from the last checkpoint, perhaps with a lower learning rate)");
+    (loss.total / b).backward();
+    mean.l1 += loss.l1 / b;
+    mean.second += loss.second / b;
+  }
+  optimizer_->step();
+  ++step_;
+  mean.total = torch::tensor(mean.l1 + mean.second);
+  last_loss_ = mean.l1 + mean.second;
+  return mean;
+}
+
+ValidationResult Trainer::Validate() {
+  ValidationResult result;
+  result.step = step_;
+  torch::NoGradGuard no_grad;
+  net_->eval();
+  WarpSettings warp;
+  warp.occlusion_tolerance = options_.occlusion_tolerance;
+  warp.inf_depth = config_.inf_depth;
+  int total_views = 0;
+  for (const PackedScene& scene : val_scenes_) {
+    ValidationResult::Scene r;
+    r.path = scene.path;
+    const int n = scene.num_views();
+    const int count = std::min(n, options_.val_views);
+    double seconds = 0;
+    for (int i = 0; i < count; ++i) {
+      const int target = static_cast<int>(static_cast<int64_t>(i) * n / count);
+      const auto sources = SelectTrainingSources(scene, target, options_.num_sources);
+      if (sources.empty()) continue;
+      const TrainingSample sample =
+          MakeSample(scene, target, sources, 0, 0, scene.width(), scene.height(), warp);
+      Timer timer;
+      const DeviceSample s = ToDevice(sample, device_);
+      const BlendOutput out =
+          net_->Forward(s.sources, s.grid, s.valid_depth, s.valid_warp);
+      const torch::Tensor prediction = ((out.rgb + 1.0) * 0.5).clamp(0.0, 1.0);
+      if (device_.is_cuda()) torch::cuda::synchronize();
+      seconds += timer.Seconds();
+      const double mse = (prediction - s.target).pow(2).mean().item<double>();
+      r.psnr += 10.0 * std::log10(1.0 / std::max(mse, 1e-10));
+      r.ssim += Ssim(prediction, s.target).item<double>();
+      ++r.views;
+    }
+    if (r.views == 0) continue;
+    result.psnr += r.psnr;
+    result.ssim += r.ssim;
+    result.seconds_per_view += seconds;
+    total_views += r.views;
+    r.psnr /= r.views;
+    r.ssim /= r.views;
+    r.seconds_per_view = seconds / r.views;
+    result.scenes.push_back(r);
+  }
+  net_->train();
+  if (total_views > 0) {
+    result.psnr /= total_views;
+    result.ssim /= total_views;
+    result.seconds_per_view /= total_views;
+  }
+  // validation.csv: append atomically (the old rows and the new, then rename).
+  std::filesystem::create_directories(options_.output_path);
+  const std::string csv = options_.output_path + "/validation.csv";
+  std::string text;
+  if (std::filesystem::exists(csv)) text = ReadFileToString(csv);
+  if (text.empty()) text = "step,scene,views,psnr,ssim,seconds_per_view\n";
+  std::ostringstream rows;
+  rows << std::setprecision(6);
+  for (const auto& r : result.scenes) {
+    rows << step_ << "," << r.path << "," << r.views << "," << r.psnr << "," << r.ssim
+         << "," << r.seconds_per_view << "\n";
+  }
+  rows << step_ << ",all," << total_views << "," << result.psnr << "," << result.ssim
+       << "," << result.seconds_per_view << "\n";
+  text += rows.str();
+  WriteFileAtomic(csv, [&](std::ostream& out) { out << text; });
+  if (!options_.quiet) {
+    std::cerr << "[train] validation at step " << step_ << ": PSNR " << std::fixed
+              << std::setprecision(2) << result.psnr << " dB, SSIM "
+              << std::setprecision(4) << result.ssim << ", " << std::setprecision(3)
+              << result.seconds_per_view << " s/view (" << total_views << " views)\n";
+  }
+  last_validation_ = result;
+  has_validation_ = true;
+  return result;
+}
+
+std::string Trainer::HardwareDescription() const {
+  std::ostringstream s;
+  if (device_.is_cuda()) {
+    s << "CUDA (" << torch::cuda::device_count() << " device(s) visible), host ";
+  } else {
+    s << "CPU, " << torch::get_num_threads() << " LibTorch threads, ";
+  }
+  s << std::thread::hardware_concurrency() << " cores, " << CpuModel();
+  return s.str();
+}
+
+std::string Trainer::SaveModel() {
+  std::filesystem::create_directories(options_.output_path);
+  const std::string path = options_.output_path + "/model.safetensors";
+  SaveWeights(net_, config_, path, options_.fp16_weights);
+  nlohmann::json card;
+  card["weights"] = "model.safetensors";
+  card["variant"] = config_.variant;
+  card["config"] = nlohmann::json::parse(config_.ToJson());
+  card["loss"] = loss_->Name();
+  card["steps"] = step_;
+  card["batch_size"] = options_.batch_size;
+  card["crop"] = options_.crop;
+  card["num_sources"] = options_.num_sources;
+  card["learning_rate"] = options_.learning_rate;
+  card["seed"] = options_.seed;
+  card["augment"] = options_.augment;
+  card["hours"] = train_seconds_ / 3600.0;
+  card["hardware"] = HardwareDescription();
+  card["libtorch"] = std::to_string(TORCH_VERSION_MAJOR) + "." +
+                     std::to_string(TORCH_VERSION_MINOR) + "." +
+                     std::to_string(TORCH_VERSION_PATCH);
+  card["written"] = UtcNow();
+  card["final_loss"] = last_loss_;
+  auto scene_list = [](const std::vector<PackedScene>& scenes) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& s : scenes) {
+      list.push_back({{"path", s.path},
+                      {"views", s.num_views()},
+                      {"width", s.width()},
+                      {"height", s.height()}});
+    }
+    return list;
+  };
+  card["data"] = {{"train", scene_list(train_scenes_)},
+                  {"validation", scene_list(val_scenes_)}};
+  if (has_validation_) {
+    nlohmann::json v = {{"step", last_validation_.step},
+                        {"psnr", last_validation_.psnr},
+                        {"ssim", last_validation_.ssim},
+                        {"seconds_per_view", last_validation_.seconds_per_view}};
+    for (const auto& r : last_validation_.scenes) {
+      v["scenes"].push_back({{"path", r.path},
+                             {"views", r.views},
+                             {"psnr", r.psnr},
+                             {"ssim", r.ssim},
+                             {"seconds_per_view", r.seconds_per_view}});
+    }
+    card["validation"] = v;
+  }
+  WriteFileAtomic(options_.output_path + "/model.json",
+                  [&](std::ostream& out) { out << card.dump(2) << "\n"; });
+  return path;
+}
+
+TrainSummary Trainer::Run() {
+  TrainSummary summary;
+  summary.resumed_from = resumed_from_;
+  Timer total;
+  StopSignals signals;
+  Timer since_checkpoint, window;
+  double window_loss = 0, window_l1 = 0, window_second = 0;
+  int window_steps = 0;
+  const int first_step = step_;
+  if (!options_.quiet) {
+    std::cerr << "[train] " << config_.variant << " on " << HardwareDescription() << ", "
+              << train_scenes_.size() << " scene(s), loss " << loss_->Name() << ", step "
+              << step_ << " -> " << options_.max_steps << "\n";
+  }
+  while (step_ < options_.max_steps) {
+    Timer step_timer;
+    const LossValue loss = Step();
+    train_seconds_ += step_timer.Seconds();
+    window_loss += loss.l1 + loss.second;
+    window_l1 += loss.l1;
+    window_second += loss.second;
+    ++window_steps;
+    if (step_ % options_.log_every == 0 || step_ == options_.max_steps) {
+      const double rate = window_steps * options_.batch_size / window.Seconds();
+      const double eta = (options_.max_steps - step_) * options_.batch_size / rate;
+      summary.final_loss = window_loss / window_steps;
+      if (!options_.quiet) {
+        std::cerr << "[train] step " << step_ << "/" << options_.max_steps << "  loss "
+                  << std::fixed << std::setprecision(4) << window_loss / window_steps
+                  << " (l1 " << window_l1 / window_steps << ", "
+                  << (loss_->perceptual() ? "vgg " : "1-ssim ")
+                  << window_second / window_steps << ")  " << std::setprecision(2) << rate
+                  << " samples/s  ETA " << FormatDuration(eta) << "\n";
+      }
+      window_loss = window_l1 = window_second = 0;
+      window_steps = 0;
+      window.Restart();
+    }
+    const bool periodic_checkpoint = options_.checkpoint_every_steps > 0 &&
+                                     step_ % options_.checkpoint_every_steps == 0;
+    if (periodic_checkpoint ||
+        since_checkpoint.Seconds() >= options_.checkpoint_minutes * 60) {
+      SaveCheckpoint();
+      since_checkpoint.Restart();
+    }
+    if (!val_scenes_.empty() && options_.val_every > 0 &&
+        step_ % options_.val_every == 0 && step_ < options_.max_steps) {
+      Validate();
+    }
+    if (g_stop_requested) {
+      const std::string path = SaveCheckpoint();
+      std::cerr << "[train] interrupted at step " << step_ << "; checkpoint " << path
+                << " (run again to resume)\n";
+      summary.interrupted = true;
+      break;
+    }
+  }
+  if (!summary.interrupted) {
+    if (window_steps > 0) summary.final_loss = window_loss / window_steps;
+    if (step_ > first_step || ListCheckpoints(options_.output_path).empty())
+      SaveCheckpoint();
+    if (!val_scenes_.empty()) Validate();
+    summary.model_path = SaveModel();
+    if (!options_.quiet) {
+      std::cerr << "[train] done: " << summary.model_path << " after " << step_
+                << " steps (" << FormatDuration(train_seconds_) << " of training)\n";
+    }
+  }
+  summary.steps_done = step_;
+  summary.seconds = total.Seconds();
+  return summary;
+}
+
+TrainSummary RunTraining(const TrainOptions& options) { return Trainer(options).Run(); }
+
+}  // namespace fvs

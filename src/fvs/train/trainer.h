@@ -1,0 +1,84 @@
+// The training loop: packed scenes -> FvsNet weights. One Trainer per output folder M:
+//   M/checkpoint-<step>.pt   model + Adam state + step + sampler RNG + torch RNG (atomic,
+//                            the newest keep_checkpoints kept); the constructor resumes
+//                            from the newest one that loads, falling back past corrupt
+//                            ones
+//   M/validation.csv         step, scene, views, PSNR, SSIM, seconds per view
+//   M/model.safetensors      final weights (SaveWeights) and M/model.json, its card
+#pragma once
+
+#include <torch/torch.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fvs/net/net.h"
+#include "fvs/train/data.h"
+#include "fvs/train/loss.h"
+#include "fvs/train/train_options.h"
+
+namespace fvs {
+
+struct ValidationResult {
+  int step = 0;
+  struct Scene {
+    std::string path;
+    int views = 0;
+    double psnr = 0, ssim = 0, seconds_per_view = 0;
+  };
+  std::vector<Scene> scenes;
+  double psnr = 0, ssim = 0, seconds_per_view = 0;  // means over all views
+};
+
+class Trainer {
+ public:
+  // Loads and checks the data, builds the network and Adam, resumes when M holds a
+  // checkpoint. Throws fvs::Error on bad input (scene list, too few views, all
+  // checkpoints corrupt, a checkpoint of another network).
+  explicit Trainer(const TrainOptions& options);
+
+  // One optimiser step over batch_size samples; returns the mean loss.
+  LossValue Step();
+  // Leave-one-out on the validation scenes at full packed size; appends validation.csv.
+  ValidationResult Validate();
+  // M/checkpoint-<step>.pt, atomically; removes all but the newest keep_checkpoints.
+  std::string SaveCheckpoint();
+  // Weights and card at M/model.safetensors, M/model.json.
+  std::string SaveModel();
+  // The whole loop to max_steps with progress, checkpoints, validation; stops cleanly on
+  // SIGINT / SIGTERM after writing a checkpoint.
+  TrainSummary Run();
+
+  int step() const { return step_; }
+  int resumed_from() const { return resumed_from_; }
+  FvsNet& net() { return net_; }
+  const ModelConfig& config() const { return config_; }
+  const torch::Device& device() const { return device_; }
+
+  // checkpoint-<step>.pt files of a folder, newest (highest step) first.
+  static std::vector<std::pair<int, std::string>> ListCheckpoints(const std::string& dir);
+
+ private:
+  // Returns false (with the reason) when the file cannot be used.
+  bool LoadCheckpoint(const std::string& path, std::string* why);
+  void Resume();
+  std::string HardwareDescription() const;
+
+  TrainOptions options_;
+  ModelConfig config_;
+  torch::Device device_ = torch::kCPU;
+  std::vector<PackedScene> train_scenes_, val_scenes_;
+  FvsNet net_{nullptr};
+  std::unique_ptr<torch::optim::Adam> optimizer_;
+  std::unique_ptr<TrainingSampler> sampler_;
+  std::unique_ptr<TrainingLoss> loss_;
+  int step_ = 0;
+  int resumed_from_ = -1;
+  double train_seconds_ = 0;  // all invocations, for the card
+  double last_loss_ = 0;
+  ValidationResult last_validation_;
+  bool has_validation_ = false;
+};
+
+}  // namespace fvs

@@ -1,0 +1,285 @@
+// The trainer end to end on a tiny packed scene and a tiny network: the loss goes down on
+// a fixed sample, a resumed run is bit-identical to an uninterrupted one, a corrupt
+// newest checkpoint falls back to the previous one, bad input gives clear errors, VGG19
+// weights load by name.
+#include "fvs/train/trainer.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "fvs/train/data.h"
+#include "fvs/train/loss.h"
+#include "fvs/train/pack.h"
+#include "fvs/util/atomic_file.h"
+#include "fvs/util/error.h"
+#include "fvs/util/safetensors.h"
+#include "scene/scene_fixture.h"
+#include "support/test_support.h"
+
+namespace fvs {
+namespace {
+
+using testing::TempDir;
+
+// A few thousand parameters: steps take milliseconds on 2 cores.
+const char kTinyNet[] =
+    R"({"variant": "fvs_fast", "feature_channels": 8, "encoder_channels": [8, 16, 16],
+        "encoder_convs": [1, 1, 1], "blend_channels": [8, 16, 16], "blend_convs_per_stage": 2})";
+
+class TrainerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new TempDir();
+    const Scene scene = testing::MakeTestScene(6, 64, 48);
+    PackOptions options;
+    options.scale = 1.0;
+    PackScene(scene, options, dir_->path() + "/scene_a");
+    const Scene small = testing::MakeTestScene(3, 64, 48);
+    PackScene(small, options, dir_->path() + "/scene_small");
+    testing::WriteTextFile(dir_->path() + "/train.txt", "scene_a\n");
+    testing::WriteTextFile(dir_->path() + "/val.txt", "scene_small\n");
+  }
+  static void TearDownTestSuite() { delete dir_; }
+
+  static TrainOptions Options(const std::string& output) {
+    TrainOptions o;
+    o.scene_list = dir_->path() + "/train.txt";
+    o.output_path = dir_->path() + "/" + output;
+    o.model_config_json = kTinyNet;
+    o.num_sources = 2;
+    o.crop = 32;
+    o.max_steps = 4;
+    o.log_every = 2;
+    o.quiet = true;
+    // One thread: on a loaded 2-core machine OpenMP's spinning threads cost more than
+    // they give at these sizes (and the resume test needs the same count in every run
+    // anyway).
+    o.num_threads = 1;
+    return o;
+  }
+  static TempDir* dir_;
+};
+TempDir* TrainerTest::dir_ = nullptr;
+
+TEST_F(TrainerTest, LossDecreasesOnAFixedSample) {
+  torch::set_num_threads(1);
+  torch::manual_seed(0);
+  const PackedScene scene = LoadPackedScene(dir_->path() + "/scene_a");
+  const TrainingSample s = MakeSample(scene, 2, SelectTrainingSources(scene, 2, 2), 16, 8,
+                                      32, 32, WarpSettings());
+  FvsNet net(ModelConfig::FromJson(kTinyNet));
+  torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(3e-3));
+  TrainingLoss loss("", torch::kCPU);
+  double first = 0, last = 0;
+  for (int i = 0; i < 30; ++i) {
+    adam.zero_grad();
+    const BlendOutput out =
+        net->Forward(s.source_rgb, s.warp.grid, s.warp.valid_depth, s.warp.valid_warp);
+    LossValue l = loss((out.rgb + 1) * 0.5, s.target_rgb);
+    l.total.backward();
+    adam.step();
+    (i == 0 ? first : last) = l.l1 + l.second;
+  }
+  EXPECT_TRUE(std::isfinite(last));
+  EXPECT_LT(last, 0.7 * first) << "first " << first << " last " << last;
+}
+
+TEST_F(TrainerTest, SsimIsOneForEqualImagesAndLowerOtherwise) {
+  const torch::Tensor a = torch::rand({1, 3, 20, 24});
+  EXPECT_NEAR(Ssim(a, a).item<double>(), 1.0, 1e-5);
+  EXPECT_LT(Ssim(a, torch::rand({1, 3, 20, 24})).item<double>(), 0.2);
+  EXPECT_THROW(Ssim(torch::rand({1, 3, 8, 8}), torch::rand({1, 3, 8, 8})), Error);
+}
+
+TEST_F(TrainerTest, ResumedRunIsBitIdenticalToAnUninterruptedOne) {
+  TrainOptions straight = Options("straight");
+  straight.val_scene_list = dir_->path() + "/val.txt";
+  straight.val_every = 2;
+  straight.val_views = 2;
+  const TrainSummary a = RunTraining(straight);
+  EXPECT_EQ(a.steps_done, 4);
+  EXPECT_EQ(a.resumed_from, -1);
+  EXPECT_TRUE(std::isfinite(a.final_loss));
+
+  TrainOptions first = Options("resumed");
+  first.max_steps = 2;
+  EXPECT_EQ(RunTraining(first).steps_done, 2);
+  TrainOptions second = Options("resumed");
+  const TrainSummary b = RunTraining(second);
+  EXPECT_EQ(b.resumed_from, 2);
+  EXPECT_EQ(b.steps_done, 4);
+
+  const SafeTensorsFile wa = ReadSafeTensors(a.model_path);
+  const SafeTensorsFile wb = ReadSafeTensors(b.model_path);
+  ASSERT_EQ(wa.tensors.size(), wb.tensors.size());
+  for (size_t i = 0; i < wa.tensors.size(); ++i) {
+    EXPECT_EQ(wa.tensors[i].name, wb.tensors[i].name);
+    EXPECT_TRUE(wa.tensors[i].data == wb.tensors[i].data) << wa.tensors[i].name;
+  }
+  // And the weights did move away from the initialisation (same seed, no steps).
+  torch::manual_seed(0);
+  const ModelConfig tiny = ModelConfig::FromJson(kTinyNet);
+  FvsNet fresh(tiny);
+  SaveWeights(fresh, tiny, dir_->path() + "/fresh.safetensors", false);
+  const SafeTensorsFile w0 = ReadSafeTensors(dir_->path() + "/fresh.safetensors");
+  int changed = 0;
+  for (size_t i = 0; i < w0.tensors.size(); ++i)
+    changed += w0.tensors[i].data != wa.tensors[i].data;
+  EXPECT_GT(changed, 0);
+  // Validation wrote its rows (two passes: step 2 and the end).
+  const std::string csv = ReadFileToString(dir_->path() + "/straight/validation.csv");
+  EXPECT_NE(csv.find("step,scene,views,psnr,ssim,seconds_per_view"), std::string::npos);
+  EXPECT_NE(csv.find("\n2,all,2,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n4,all,2,"), std::string::npos) << csv;
+  const std::string card = ReadFileToString(dir_->path() + "/straight/model.json");
+  EXPECT_NE(card.find("\"validation\""), std::string::npos);
+  EXPECT_NE(card.find("\"steps\": 4"), std::string::npos);
+  // Only the newest two checkpoints are kept.
+  const auto checkpoints = Trainer::ListCheckpoints(dir_->path() + "/straight");
+  ASSERT_EQ(checkpoints.size(), 1u);  // a single one was written (at the end)
+  EXPECT_EQ(checkpoints[0].first, 4);
+  // The model loads through the net's own loader.
+  ModelConfig config;
+  FvsNet loaded = LoadModel(a.model_path, &config);
+  EXPECT_EQ(config.ToJson(), ModelConfig::FromJson(kTinyNet).ToJson());
+}
+
+TEST_F(TrainerTest, CorruptNewestCheckpointFallsBackToThePrevious) {
+  TrainOptions o = Options("corrupt");
+  o.max_steps = 3;
+  o.checkpoint_every_steps = 1;
+  RunTraining(o);
+  auto checkpoints = Trainer::ListCheckpoints(o.output_path);
+  ASSERT_EQ(checkpoints.size(), 2u);  // keep_checkpoints = 2
+  EXPECT_EQ(checkpoints[0].first, 3);
+  EXPECT_EQ(checkpoints[1].first, 2);
+  // Truncate the newest.
+  const std::string bytes = ReadFileToString(checkpoints[0].second);
+  {
+    std::ofstream out(checkpoints[0].second, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), bytes.size() / 3);
+  }
+  {
+    Trainer trainer(o);
+    EXPECT_EQ(trainer.resumed_from(), 2);
+    EXPECT_EQ(trainer.step(), 2);
+  }
+  // Both unusable: a clear error rather than a silent fresh start.
+  {
+    std::ofstream out(checkpoints[1].second, std::ios::binary | std::ios::trunc);
+    out << "garbage";
+  }
+  try {
+    Trainer trainer(o);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no usable checkpoint"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST_F(TrainerTest, BadInputGivesClearErrors) {
+  // Too few views for K sources (3 views, K = 5 needs 6).
+  TrainOptions o = Options("bad");
+  o.scene_list = dir_->path() + "/val.txt";
+  o.num_sources = 5;
+  try {
+    Trainer trainer(o);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("needs at least 6"), std::string::npos)
+        << e.what();
+  }
+  // A missing scene, named with its line.
+  testing::WriteTextFile(dir_->path() + "/bad.txt", "scene_a\nno_such_scene\n");
+  o = Options("bad");
+  o.scene_list = dir_->path() + "/bad.txt";
+  try {
+    Trainer trainer(o);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.txt:2"), std::string::npos) << e.what();
+  }
+  // A checkpoint of another network is refused, not mixed in.
+  TrainOptions small = Options("other_net");
+  small.max_steps = 1;
+  RunTraining(small);
+  TrainOptions other = Options("other_net");
+  other.model_config_json.clear();
+  other.variant = "fvs_fast";
+  EXPECT_THROW(Trainer trainer(other), Error);
+  // Option parsing.
+  TrainOptions parsed;
+  std::vector<std::string> args = {"prog",    "--scene_list",      "L", "--output_path",
+                                   "M",       "--Train.max_steps", "7", "--Train.variant",
+                                   "fvs_fast"};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  EXPECT_TRUE(ParseTrainOptions(static_cast<int>(argv.size()), argv.data(), 1, &parsed));
+  EXPECT_EQ(parsed.max_steps, 7);
+  EXPECT_EQ(parsed.variant, "fvs_fast");
+  args = {"prog", "--scene_list", "L", "--output_path", "M", "--Train.max_steps", "x"};
+  argv.clear();
+  for (auto& a : args) argv.push_back(a.data());
+  EXPECT_THROW(ParseTrainOptions(static_cast<int>(argv.size()), argv.data(), 1, &parsed),
+               Error);
+  args = {"prog", "--output_path", "M"};
+  argv.clear();
+  for (auto& a : args) argv.push_back(a.data());
+  EXPECT_THROW(ParseTrainOptions(static_cast<int>(argv.size()), argv.data(), 1, &parsed),
+               Error);
+}
+
+TEST_F(TrainerTest, PerceptualLossLoadsVgg19ByName) {
+  // Random weights under torchvision's names (real ones cannot be downloaded here).
+  torch::manual_seed(1);
+  SafeTensorsFile file;
+  for (const auto& [name, shape] : Vgg19FeaturesImpl::ExpectedTensors()) {
+    const int64_t fan_in = shape.size() == 4 ? shape[1] * 9 : 1;
+    const torch::Tensor t = (torch::randn(shape) * std::sqrt(2.0 / fan_in)).contiguous();
+    file.Add(SafeTensor::FromFloats(name, shape, t.data_ptr<float>()));
+  }
+  const std::string path = dir_->path() + "/vgg19.safetensors";
+  WriteSafeTensors(path, file);
+  TrainingLoss loss(path, torch::kCPU);
+  EXPECT_TRUE(loss.perceptual());
+  const torch::Tensor a = torch::rand({1, 3, 32, 32});
+  const torch::Tensor b = torch::rand({1, 3, 32, 32}).requires_grad_(true);
+  EXPECT_NEAR(loss(a, a).second, 0.0, 1e-7);
+  LossValue d = loss(b, a);
+  EXPECT_GT(d.second, 0.0);
+  d.total.backward();
+  EXPECT_GT(b.grad().abs().sum().item<float>(), 0.f);
+  // A file missing a layer names it.
+  SafeTensorsFile partial;
+  for (const auto& t : file.tensors) {
+    if (t.name != "features.21.weight") partial.Add(t);
+  }
+  WriteSafeTensors(dir_->path() + "/vgg_partial.safetensors", partial);
+  try {
+    TrainingLoss bad(dir_->path() + "/vgg_partial.safetensors", torch::kCPU);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("features.21.weight"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST_F(TrainerTest, StandaloneBinaryReportsBadListsWithTheLine) {
+  const std::string binary = std::string(FVS_BINARY_DIR) + "/bin/fvs_train_main";
+  ASSERT_TRUE(std::filesystem::exists(binary)) << "build the fvs_train_main target";
+  testing::WriteTextFile(dir_->path() + "/missing.txt", "scene_a\n\nnowhere\n");
+  std::string output;
+  const int rc =
+      testing::RunShell(binary + " --scene_list " + dir_->path() +
+                            "/missing.txt --output_path " + dir_->path() + "/cli 2>&1",
+                        &output);
+  EXPECT_NE(rc, 0);
+  EXPECT_NE(output.find("missing.txt:3"), std::string::npos) << output;
+  EXPECT_EQ(testing::RunShell(binary + " -h > /dev/null"), 0);
+}
+
+}  // namespace
+}  // namespace fvs
