@@ -1,0 +1,144 @@
+#include "fvs/render/fvs_method.h"
+
+#include <torch/torch.h>
+
+#include <list>
+#include <map>
+
+#include "fvs/net/net.h"
+#include "fvs/render/prepare.h"
+#include "fvs/scene/scene.h"
+#include "fvs/util/error.h"
+#include "fvs/util/progress.h"
+
+namespace fvs {
+namespace {
+
+// [H,W,C] float image -> [1,C,H,W] tensor (a copy).
+torch::Tensor ToTensor(const Image& image) {
+  return torch::from_blob(const_cast<float*>(image.data.data()),
+                          {image.height, image.width, image.channels}, torch::kFloat32)
+      .permute({2, 0, 1})
+      .unsqueeze(0)
+      .contiguous();
+}
+
+Image ToImage(const torch::Tensor& chw) {
+  const torch::Tensor hwc = chw.squeeze(0).permute({1, 2, 0}).contiguous().to(torch::kCPU);
+  Image image(static_cast<int>(hwc.size(1)), static_cast<int>(hwc.size(0)),
+              static_cast<int>(hwc.size(2)));
+  std::memcpy(image.data.data(), hwc.data_ptr<float>(), image.data.size() * sizeof(float));
+  return image;
+}
+
+class FvsMethod : public Method {
+ public:
+  FvsMethod(FvsNet net, ModelConfig config, const RenderOptions& options)
+      : net_(std::move(net)), config_(std::move(config)), options_(options) {
+    net_->eval();
+  }
+
+  std::string name() const override { return config_.variant; }
+
+  RenderResult Render(const Scene& scene, const TargetView& target) override {
+    torch::NoGradGuard no_grad;
+    PreparedTarget prepared = PrepareTarget(scene, target, options_);
+    RenderResult result;
+    result.depth = std::move(prepared.depth);
+    result.sources = prepared.sources;
+    result.timings = prepared.timings;
+    const int w = target.camera.width, h = target.camera.height;
+    result.color = Image(w, h, 3, 0.0f);
+    result.confidence = Image(w, h, 1, 0.0f);
+    result.coverage = Image(w, h, 1, 0.0f);
+    const int k = static_cast<int>(prepared.sources.size());
+    if (k == 0) return result;  // no source sees anything: black, coverage 0
+
+    Timer timer;
+    std::vector<torch::Tensor> warped, valid_warp;
+    for (int i = 0; i < k; ++i) {
+      const int view = prepared.sources[i].view_index;
+      const torch::Tensor& features = Features(scene, view);
+      const Image grid = GridSampleCoordinates(prepared.warps[i],
+                                               scene.view(view).camera.width,
+                                               scene.view(view).camera.height);
+      const torch::Tensor grid_t = ToTensor(grid).permute({0, 2, 3, 1});  // [1,H,W,2]
+      warped.push_back(WarpFeatures(features, grid_t));
+      valid_warp.push_back(ToTensor(prepared.warps[i].valid_warp));
+    }
+    result.timings.encode_s = encode_seconds_;
+    encode_seconds_ = 0;
+    torch::Tensor valid_depth = ToTensor(prepared.warps[0].valid_depth);
+    torch::Tensor warp_mask = torch::cat(valid_warp, 0);
+    if (!config_.inf_depth) {
+      // Without the "far away" convention a pixel with no surface has no valid warp.
+      warp_mask = warp_mask * valid_depth;
+    }
+    const BlendOutput out = net_->Blend(torch::cat(warped, 0), valid_depth, warp_mask);
+    // [-1,1] -> [0,1]; the net clamps and removes NaN at inference.
+    result.color = ToImage((out.rgb + 1.0) * 0.5);
+    const torch::Tensor covered = (warp_mask.sum(0, true) > 0).to(torch::kFloat32);
+    result.coverage = ToImage(covered);
+    if (out.weights.defined() && out.weights.numel() > 0) {
+      // How much of the blend comes from sources that really see the pixel.
+      result.confidence = ToImage((out.weights * warp_mask).sum(0, true).clamp(0.0, 1.0));
+    } else {
+      result.confidence = result.coverage;
+    }
+    result.timings.blend_s = timer.Seconds() - result.timings.encode_s;
+    return result;
+  }
+
+ private:
+  // Encoded features of a source view, cached (least recently used out first) so a path
+  // of targets encodes each source once.
+  const torch::Tensor& Features(const Scene& scene, int view) {
+    const auto it = cache_.find(view);
+    if (it != cache_.end()) {
+      order_.remove(view);
+      order_.push_front(view);
+      return it->second;
+    }
+    Timer timer;
+    const torch::Tensor image = ToTensor(scene.SourceImage(view)) * 2.0 - 1.0;
+    torch::Tensor features = net_->Encode(image);
+    encode_seconds_ += timer.Seconds();
+    while (static_cast<int>(cache_.size()) >= kMaxCachedSources && !order_.empty()) {
+      cache_.erase(order_.back());
+      order_.pop_back();
+    }
+    order_.push_front(view);
+    return cache_.emplace(view, std::move(features)).first->second;
+  }
+
+  // 64 channels x 640 x 480 x 4 bytes = 79 MB a source: 24 keep memory near 2 GB.
+  static constexpr int kMaxCachedSources = 24;
+
+  FvsNet net_;
+  ModelConfig config_;
+  RenderOptions options_;
+  std::map<int, torch::Tensor> cache_;
+  std::list<int> order_;
+  double encode_seconds_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Method> CreateFvsMethod(const std::string& requested,
+                                        const RenderOptions& options) {
+  if (options.model_path.empty()) {
+    throw Error("--method " + requested,
+                "method " + requested +
+                    " needs model weights: --model_path <weights.safetensors>");
+  }
+  ConfigureTorchThreads();
+  ModelConfig config;
+  FvsNet net = LoadModel(options.model_path, &config);
+  if (requested != "fvs" && requested != config.variant) {
+    throw Error(options.model_path, "weights are of variant '" + config.variant +
+                                        "', not '" + requested + "'");
+  }
+  return std::make_unique<FvsMethod>(std::move(net), std::move(config), options);
+}
+
+}  // namespace fvs

@@ -1,0 +1,19 @@
+// The network as a rendering method (`--method fvs`, or a variant name such as `fvs_fast`):
+// the shared geometric front end (PrepareTarget), then the sources' features encoded once
+// and cached across targets, warped into the target with grid_sample, blended by the
+// recurrent network. No torch in this header.
+#pragma once
+
+#include <memory>
+
+#include "fvs/render/method.h"
+
+namespace fvs {
+
+// Loads options.model_path (throws fvs::Error naming the file on missing or mismatched
+// weights). `requested` is the --method name: "fvs" accepts any variant, a variant name
+// must match the weights' config.
+std::unique_ptr<Method> CreateFvsMethod(const std::string& requested,
+                                        const RenderOptions& options);
+
+}  // namespace fvs

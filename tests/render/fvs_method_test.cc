@@ -1,0 +1,112 @@
+// The network as a rendering method, with small random-weight models made here: finite,
+// deterministic output of the target's size, source features encoded once across targets,
+// and clear errors for missing or mismatched weights. (Image quality needs trained weights:
+// that is the training issue's and the evaluation's business.)
+#include "fvs/render/fvs_method.h"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include "fvs/net/net.h"
+#include "fvs/render/method.h"
+#include "fvs/util/error.h"
+#include "scene/scene_fixture.h"
+#include "support/test_support.h"
+
+namespace fvs {
+namespace {
+
+std::string SaveRandomModel(const std::string& dir, const std::string& variant) {
+  torch::manual_seed(7);
+  const ModelConfig config = ModelConfig::ForVariant(variant);
+  FvsNet net(config);
+  const std::string path = dir + "/" + variant + ".safetensors";
+  SaveWeights(net, config, path, /*fp16=*/false);
+  return path;
+}
+
+TargetView HeldOutTarget(const Scene& scene, int view) {
+  TargetView target;
+  target.name = "target";
+  target.camera = scene.view(view).camera;
+  target.exclude_views = {view};
+  return target;
+}
+
+TEST(FvsMethod, FiniteDeterministicAndCached) {
+  testing::TempDir dir;
+  const Scene scene = testing::MakeTestScene(5, 48, 36);
+  RenderOptions options;
+  options.num_sources = 3;
+  options.model_path = SaveRandomModel(dir.path(), "fvs_fast");
+  std::unique_ptr<Method> method = CreateMethod("fvs", options);
+  EXPECT_EQ(method->name(), "fvs_fast");
+
+  const TargetView target = HeldOutTarget(scene, 2);
+  const RenderResult a = method->Render(scene, target);
+  ASSERT_EQ(a.color.width, 48);
+  ASSERT_EQ(a.color.height, 36);
+  ASSERT_EQ(a.color.channels, 3);
+  EXPECT_TRUE(testing::AllFinite(a.color));
+  EXPECT_TRUE(testing::AllFinite(a.confidence));
+  for (float v : a.color.data) {
+    EXPECT_GE(v, 0.0f);
+    EXPECT_LE(v, 1.0f);
+  }
+  EXPECT_EQ(a.sources.size(), 3u);
+  for (const SourceScore& s : a.sources) EXPECT_NE(s.view_index, 2);
+  EXPECT_GT(a.timings.encode_s, 0.0);
+
+  // Same target again: identical image, and no source encoded a second time.
+  const RenderResult b = method->Render(scene, target);
+  EXPECT_EQ(a.color.data, b.color.data);
+  EXPECT_EQ(b.timings.encode_s, 0.0);
+}
+
+TEST(FvsMethod, EveryVariantRendersFiniteImages) {
+  testing::TempDir dir;
+  const Scene scene = testing::MakeTestScene(4, 40, 32);
+  for (const std::string& variant : {"fvs", "fvs_nogru", "fvs_nomasks", "fvs_noinfdepth",
+                                     "fvs_single"}) {
+    RenderOptions options;
+    options.num_sources = 2;
+    options.model_path = SaveRandomModel(dir.path(), variant);
+    const RenderResult r = CreateMethod(variant, options)->Render(scene, HeldOutTarget(scene, 1));
+    EXPECT_TRUE(testing::AllFinite(r.color)) << variant;
+    EXPECT_EQ(r.color.width, 40) << variant;
+  }
+}
+
+TEST(FvsMethod, NoSourceSeesTheTargetGivesBlack) {
+  testing::TempDir dir;
+  const Scene scene = testing::MakeTestScene(3, 40, 32);
+  RenderOptions options;
+  options.model_path = SaveRandomModel(dir.path(), "fvs_fast");
+  TargetView target = HeldOutTarget(scene, 0);
+  // Looking straight up out of the room's top... the room is closed, so look from outside
+  // it, away from everything.
+  target.camera = testing::LookAtCamera(Eigen::Vector3d(0, 0, 50), Eigen::Vector3d(0, 0, 100),
+                                        40, 32);
+  const RenderResult r = CreateMethod("fvs", options)->Render(scene, target);
+  EXPECT_TRUE(r.sources.empty());
+  for (float v : r.color.data) EXPECT_EQ(v, 0.0f);
+}
+
+TEST(FvsMethod, MissingOrMismatchedWeightsAreOneLineErrors) {
+  testing::TempDir dir;
+  RenderOptions options;
+  EXPECT_THROW(CreateMethod("fvs", options), Error);
+  options.model_path = dir / "missing.safetensors";
+  EXPECT_THROW(CreateMethod("fvs", options), Error);
+  options.model_path = SaveRandomModel(dir.path(), "fvs_fast");
+  try {
+    CreateMethod("fvs_nogru", options);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("variant 'fvs_fast'"), std::string::npos);
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace fvs
