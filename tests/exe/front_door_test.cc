@@ -9,7 +9,7 @@
 namespace fvs::testing {
 namespace {
 
-std::string Run(const std::string& args, int* status) {
+std::string RunFrontDoor(const std::string& args, int* status) {
   std::string out;
   *status = RunShell("QT_QPA_PLATFORM=offscreen '" + FrontDoorBinary() + "' " + args, &out);
   return out;
@@ -17,7 +17,7 @@ std::string Run(const std::string& args, int* status) {
 
 TEST(FrontDoor, HelpListsColmapCommandsThenOurs) {
   int status = -1;
-  const std::string out = Run("help", &status);
+  const std::string out = RunFrontDoor("help", &status);
   EXPECT_EQ(status, 0);
   const size_t colmap_pos = out.find("COLMAP");
   const size_t ours_pos = out.find("view_synthesis_");
@@ -33,19 +33,19 @@ TEST(FrontDoor, ForwardsOtherCommandsToRealColmap) {
   // model_converter on an empty folder fails inside COLMAP: the exit code and COLMAP's own
   // message come through unchanged.
   const std::string out =
-      Run("model_converter --input_path " + dir.path() + " --output_path " + dir.path() +
+      RunFrontDoor("model_converter --input_path " + dir.path() + " --output_path " + dir.path() +
               " --output_type TXT",
           &status);
   EXPECT_NE(status, 0);
   int help_status = -1;
-  const std::string help = Run("model_converter -h", &help_status);
+  const std::string help = RunFrontDoor("model_converter -h", &help_status);
   EXPECT_EQ(help_status, 0);
   EXPECT_NE(help.find("--output_type"), std::string::npos) << help;
 }
 
 TEST(FrontDoor, UnknownOptionOfOurCommandIsOneErrorLine) {
   int status = -1;
-  const std::string out = Run("view_synthesis_synthetic --no_such_option 1", &status);
+  const std::string out = RunFrontDoor("view_synthesis_synthetic --no_such_option 1", &status);
   if (out.find("unknown command") != std::string::npos) GTEST_SKIP();
   EXPECT_EQ(status, 1);
   EXPECT_NE(out.find("ERROR: "), std::string::npos) << out;

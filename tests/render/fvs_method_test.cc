@@ -83,10 +83,9 @@ TEST(FvsMethod, NoSourceSeesTheTargetGivesBlack) {
   RenderOptions options;
   options.model_path = SaveRandomModel(dir.path(), "fvs_fast");
   TargetView target = HeldOutTarget(scene, 0);
-  // Looking straight up out of the room's top... the room is closed, so look from outside
-  // it, away from everything.
-  target.camera = testing::LookAtCamera(Eigen::Vector3d(0, 0, 50), Eigen::Vector3d(0, 0, 100),
-                                        40, 32);
+  // Far above the closed room, looking horizontally away from it: nothing in view.
+  target.camera = testing::LookAtCamera(Eigen::Vector3d(0, 0, 50),
+                                        Eigen::Vector3d(100, 0, 50), 40, 32);
   const RenderResult r = CreateMethod("fvs", options)->Render(scene, target);
   EXPECT_TRUE(r.sources.empty());
   for (float v : r.color.data) EXPECT_EQ(v, 0.0f);

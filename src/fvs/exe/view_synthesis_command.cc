@@ -128,22 +128,24 @@ int RunViewSynthesis(int argc, char** argv) {
 
   std::printf("scene: %d views, loaded in %.2f s (%d source depths computed)\n",
               scene.num_views(), scene.load_seconds(), scene.num_depths_computed());
-  std::printf("%-24s %8s %8s %8s %8s %8s %9s\n", "target", "total_s", "depth_s",
-              "select_s", "warp_s", "blend_s", "coverage");
+  std::printf("%-24s %8s %8s %8s %8s %8s %8s %9s\n", "target", "total_s", "depth_s",
+              "select_s", "warp_s", "encode_s", "blend_s", "coverage");
   RenderTimings sum;
   for (size_t i = 0; i < targets.size(); ++i) {
     const RenderTimings& t = timings[i];
-    std::printf("%-24s %8.3f %8.3f %8.3f %8.3f %8.3f %8.1f%%\n", targets[i].name.c_str(),
-                t.total(), t.depth_s, t.selection_s, t.warp_s, t.blend_s,
-                100 * coverage[i]);
+    std::printf("%-24s %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.1f%%\n",
+                targets[i].name.c_str(), t.total(), t.depth_s, t.selection_s, t.warp_s,
+                t.encode_s, t.blend_s, 100 * coverage[i]);
     sum.depth_s += t.depth_s;
     sum.selection_s += t.selection_s;
     sum.warp_s += t.warp_s;
+    sum.encode_s += t.encode_s;
     sum.blend_s += t.blend_s;
   }
   const double n = static_cast<double>(targets.size());
-  std::printf("%-24s %8.3f %8.3f %8.3f %8.3f %8.3f\n", "mean", sum.total() / n,
-              sum.depth_s / n, sum.selection_s / n, sum.warp_s / n, sum.blend_s / n);
+  std::printf("%-24s %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f\n", "mean", sum.total() / n,
+              sum.depth_s / n, sum.selection_s / n, sum.warp_s / n, sum.encode_s / n,
+              sum.blend_s / n);
   std::printf("wrote %zu images to %s\n", targets.size(), o.output_path.c_str());
   return 0;
 }

@@ -86,6 +86,7 @@ void WriteRenderOutputs(const std::string& output_dir, const std::string& name,
     json["timings_s"] = {{"depth", result.timings.depth_s},
                          {"selection", result.timings.selection_s},
                          {"warp", result.timings.warp_s},
+                         {"encode", result.timings.encode_s},
                          {"blend", result.timings.blend_s}};
     WriteFileAtomic(stem + ".sources.json",
                     [&](std::ostream& out) { out << json.dump(2) << "\n"; });
