@@ -9,7 +9,9 @@ scripts/build.sh
 
 COLMAP="$PWD/build/bin/colmap"
 OUT="${FVS_DEMO_OUTPUT:-demo_output}"
-VIEWS="${FVS_DEMO_VIEWS:-24}"
+VIEWS="${FVS_DEMO_VIEWS:-16}"
+# Stereo at 400 px keeps the CPU PatchMatch to a few minutes on 2 cores.
+STEREO_SIZE="${FVS_DEMO_STEREO_SIZE:-400}"
 export QT_QPA_PLATFORM=offscreen
 mkdir -p "$OUT"
 start=$(date +%s)
@@ -26,7 +28,8 @@ fi
 #    compared with the truth.
 last=$(ls "$OUT/synthetic/images" | sort | tail -n 1)
 "$COLMAP" view_synthesis_prepare --image_path "$OUT/synthetic/images" \
-  --workspace_path "$OUT/workspace" --holdout_images "$last"
+  --workspace_path "$OUT/workspace" --holdout_images "$last" \
+  --Stereo.max_image_size "$STEREO_SIZE"
 
 # 3. Novel views between the registered cameras with the classical ULR baseline (no weights
 #    needed), and with the network when shipped weights exist.

@@ -295,13 +295,13 @@ TEST(PatchMatchStereoTest, SyntheticSceneMeetsTheAccuracyTarget) {
   std::string output;
   ASSERT_EQ(RunShell("FVS_QUIET=1 " + Quote(colmap) +
                          " view_synthesis_synthetic --output_path " + Quote(dir.path()) +
-                         " --SyntheticScene.num_views 6 --SyntheticScene.width 320"
+                         " --SyntheticScene.num_views 8 --SyntheticScene.width 320"
                          " --SyntheticScene.height 240 --SyntheticScene.seed 3 2>&1",
                      &output),
             0)
       << output;
   const PatchMatchStereoSummary summary = RunPatchMatchStereo(dir.path(), FastOptions());
-  EXPECT_EQ(summary.num_geometric_computed, 6);
+  EXPECT_EQ(summary.num_geometric_computed, 8);
   const colmap::DenseWorkspace ws(dir.path());
   const colmap::Reconstruction rec = colmap::ReadSparseModel(ws.SparseDir());
   DepthErrorHistogram photometric, geometric;
@@ -324,6 +324,9 @@ TEST(PatchMatchStereoTest, SyntheticSceneMeetsTheAccuracyTarget) {
   EXPECT_GT(geometric.total(), 100000);
   EXPECT_GE(geometric.FractionWithin(0.01), 0.8);
   EXPECT_GE(photometric.FractionWithin(0.01), 0.75);
+  // The target is met by correct depths, not by deleting the hard pixels (they count as
+  // misses above anyway): the filter removes only a modest part.
+  EXPECT_LE(geometric.FractionWithoutDepth(), 0.15);
 
   RunFusion(dir.path());
   const PointCloud fused = ReadPlyPointCloud(ws.FusedPath());

@@ -13,6 +13,7 @@ namespace {
 constexpr float kMaxCost = 2.0f;
 constexpr int kMinCoarseSide = 64;
 constexpr int kMaxWindowSamples = 41;  // per window row: radius <= 20
+constexpr int kColourTableSize = 1024;
 constexpr double kPi = 3.14159265358979323846;
 // A plane seen nearly edge-on says nothing reliable (and its homography explodes).
 constexpr double kMinCosIncidence = 0.1;
@@ -139,11 +140,15 @@ class ViewSolver {
 
   // Perturbations shrink with the iteration number; a run that starts from converged
   // planes (finer level, geometric pass) starts at first_iteration.
-  void Iterate(int num_iterations, int first_iteration) {
+  // `refining`: the planes came from a coarser level or the photometric pass, so (with
+  // options.fast_refinement) the far neighbours and the random plane are skipped.
+  void Iterate(int num_iterations, int first_iteration, bool refining) {
+    const bool fast = refining && options_.fast_refinement;
     for (int iter = first_iteration; iter < first_iteration + num_iterations; ++iter) {
       for (int colour = 0; colour < 2; ++colour) {
         ParallelFor(
-            0, height_, [&](int64_t y) { SweepRow(static_cast<int>(y), colour, iter); },
+            0, height_,
+            [&](int64_t y) { SweepRow(static_cast<int>(y), colour, iter, fast); },
             options_.num_threads);
       }
     }
@@ -197,8 +202,31 @@ class ViewSolver {
     }
     for (int d = -r; d <= r; d += options_.window_step) offsets_.push_back(d);
     num_samples_ = static_cast<int>(offsets_.size() * offsets_.size());
+    // Bilateral weights (as COLMAP): spatial Gaussian per window sample, times a colour
+    // Gaussian of the grey difference to the centre pixel, from a table.
+    const double sigma_spatial =
+        options_.sigma_spatial > 0 ? options_.sigma_spatial : options_.window_radius;
+    for (int dy : offsets_) {
+      for (int dx : offsets_) {
+        spatial_weight_.push_back(
+            options_.sigma_color > 0
+                ? static_cast<float>(std::exp(-(dx * dx + dy * dy) /
+                                              (2 * sigma_spatial * sigma_spatial)))
+                : 1.0f);
+      }
+    }
+    colour_weight_.resize(kColourTableSize + 1);
+    for (int q = 0; q <= kColourTableSize; ++q) {
+      const double diff = static_cast<double>(q) / kColourTableSize;
+      colour_weight_[q] =
+          options_.sigma_color > 0
+              ? static_cast<float>(std::exp(
+                    -diff * diff / (2 * options_.sigma_color * options_.sigma_color)))
+              : 1.0f;
+    }
     ref_mean_.assign(static_cast<size_t>(width_) * height_, 0.f);
     ref_std_.assign(static_cast<size_t>(width_) * height_, 0.f);
+    ref_weight_sum_.assign(static_cast<size_t>(width_) * height_, 0.f);
     textured_.assign(static_cast<size_t>(width_) * height_, 0);
     ParallelFor(
         0, height_,
@@ -217,12 +245,45 @@ class ViewSolver {
             const double mean = sum / num_samples_;
             const double var = std::max(0.0, sum_sq / num_samples_ - mean * mean);
             const size_t i = Index(x, y);
-            ref_mean_[i] = static_cast<float>(mean);
-            ref_std_[i] = static_cast<float>(std::sqrt(var));
+            // The texture test stays unweighted; NCC uses the weighted moments.
             textured_[i] = std::sqrt(var) >= options_.min_texture_std ? 1 : 0;
+            float weights[kMaxWindowSamples * kMaxWindowSamples];
+            WindowWeights(x, y, weights);
+            double wsum = 0, wr = 0, wrr = 0;
+            int k = 0;
+            for (int dy : offsets_) {
+              const float* row = RefRow(y + dy);
+              for (int dx : offsets_) {
+                const double v = row[x + dx];
+                wsum += weights[k];
+                wr += weights[k] * v;
+                wrr += weights[k] * v * v;
+                ++k;
+              }
+            }
+            const double wmean = wr / wsum;
+            const double wvar = std::max(0.0, wrr / wsum - wmean * wmean);
+            ref_mean_[i] = static_cast<float>(wmean);
+            ref_std_[i] = static_cast<float>(std::sqrt(wvar));
+            ref_weight_sum_[i] = static_cast<float>(wsum);
           }
         },
         options_.num_threads);
+  }
+
+  // Bilateral weight of every window sample of pixel (x, y), row by row.
+  void WindowWeights(int x, int y, float* weights) const {
+    const float centre = RefRow(y)[x];
+    int k = 0;
+    for (int dy : offsets_) {
+      const float* row = RefRow(y + dy);
+      for (int dx : offsets_) {
+        const float diff = std::min(std::abs(row[x + dx] - centre), 1.0f);
+        weights[k] = spatial_weight_[k] *
+                     colour_weight_[static_cast<int>(diff * kColourTableSize + 0.5f)];
+        ++k;
+      }
+    }
   }
 
   const float* RefRow(int y) const {
@@ -265,14 +326,27 @@ class ViewSolver {
                                                   n.y() * intr_.cy / intr_.fy) /
                               plane_d;
     const size_t i = Index(x, y);
-    const float ref_mean = ref_mean_[i];
-    const float ref_std = ref_std_[i];
+    Window window;
+    window.ref_mean = ref_mean_[i];
+    window.ref_std = ref_std_[i];
+    window.inv_weight_sum = 1.0f / ref_weight_sum_[i];
+    WindowWeights(x, y, window.weights);
+    {
+      int k = 0;
+      for (int dy : offsets_) {
+        const float* row = RefRow(y + dy);
+        for (int dx : offsets_) {
+          window.weighted_ref[k] = window.weights[k] * row[x + dx];
+          ++k;
+        }
+      }
+    }
     float costs[64];
     const int num_sources = static_cast<int>(sources_.size());
     for (int s = 0; s < num_sources; ++s) {
       const Source& src = sources_[s];
       const Eigen::Matrix3d H = src.A + src.b * m.transpose();
-      float c = WindowCost(H, x, y, src, ref_mean, ref_std);
+      float c = WindowCost(H, x, y, src, window);
       if (photo_costs) photo_costs[s] = c;
       if (geometric_) {
         const double err = ReprojectionError(X, x, y, src);
@@ -290,8 +364,16 @@ class ViewSolver {
     return sum / top_k_;
   }
 
+  // The reference side of the weighted NCC of one pixel: the same for every source and
+  // every candidate plane.
+  struct Window {
+    float ref_mean, ref_std, inv_weight_sum;
+    float weights[kMaxWindowSamples * kMaxWindowSamples];
+    float weighted_ref[kMaxWindowSamples * kMaxWindowSamples];
+  };
+
   float WindowCost(const Eigen::Matrix3d& Hd, int x, int y, const Source& src,
-                   float ref_mean, float ref_std) const {
+                   const Window& window) const {
     // The centre must land inside the source image, in front of it.
     const Eigen::Vector3d hc = Hd * Eigen::Vector3d(x, y, 1.0);
     if (!(hc.z() > 1e-12)) return kMaxCost;
@@ -317,6 +399,8 @@ class ViewSolver {
     const int n = static_cast<int>(offsets_.size());
     float us[kMaxWindowSamples], vs[kMaxWindowSamples], samples[kMaxWindowSamples];
     float sum_s = 0, sum_ss = 0, sum_rs = 0;
+    const float* weights = window.weights;
+    const float* weighted_ref = window.weighted_ref;
     for (int dy : offsets_) {
       const float sx = static_cast<float>(x) + first, sy = static_cast<float>(y + dy);
       const float hx = H(0, 0) * sx + H(0, 1) * sy + H(0, 2);
@@ -329,7 +413,6 @@ class ViewSolver {
         us[k] = std::min(std::max((hx + kk * H(0, 0)) * inv, 0.0f), max_u);
         vs[k] = std::min(std::max((hy + kk * H(1, 0)) * inv, 0.0f), max_v);
       }
-      const float* ref_row = RefRow(y + dy) + x + offsets_.front();
       for (int k = 0; k < n; ++k) {
         const int u0 = static_cast<int>(us[k]), v0 = static_cast<int>(vs[k]);
         const float au = us[k] - u0, av = vs[k] - v0;
@@ -341,32 +424,36 @@ class ViewSolver {
       // Two accumulators each: float additions are not reordered by the compiler, and one
       // long dependency chain would bound the loop by the adder's latency.
       float s0 = 0, s1 = 0, ss0 = 0, ss1 = 0, rs0 = 0, rs1 = 0;
-      const int step_i = options_.window_step;
       int k = 0;
       for (; k + 1 < n; k += 2) {
         const float a = samples[k], b = samples[k + 1];
-        s0 += a;
-        s1 += b;
-        ss0 += a * a;
-        ss1 += b * b;
-        rs0 += ref_row[k * step_i] * a;
-        rs1 += ref_row[(k + 1) * step_i] * b;
+        const float wa = weights[k] * a, wb = weights[k + 1] * b;
+        s0 += wa;
+        s1 += wb;
+        ss0 += wa * a;
+        ss1 += wb * b;
+        rs0 += weighted_ref[k] * a;
+        rs1 += weighted_ref[k + 1] * b;
       }
       if (k < n) {
         const float a = samples[k];
-        s0 += a;
-        ss0 += a * a;
-        rs0 += ref_row[k * step_i] * a;
+        const float wa = weights[k] * a;
+        s0 += wa;
+        ss0 += wa * a;
+        rs0 += weighted_ref[k] * a;
       }
       sum_s += s0 + s1;
       sum_ss += ss0 + ss1;
       sum_rs += rs0 + rs1;
+      weights += n;
+      weighted_ref += n;
     }
-    const float inv_n = 1.0f / num_samples_;
-    const float mean_s = sum_s * inv_n;
-    const float var_s = sum_ss * inv_n - mean_s * mean_s;
+    const float inv_w = window.inv_weight_sum;
+    const float mean_s = sum_s * inv_w;
+    const float var_s = sum_ss * inv_w - mean_s * mean_s;
     if (!(var_s > 1e-8f)) return kMaxCost;
-    const float ncc = (sum_rs * inv_n - ref_mean * mean_s) / (ref_std * std::sqrt(var_s));
+    const float ncc =
+        (sum_rs * inv_w - window.ref_mean * mean_s) / (window.ref_std * std::sqrt(var_s));
     return std::clamp(1.0f - ncc, 0.0f, kMaxCost);
   }
 
@@ -416,7 +503,7 @@ class ViewSolver {
 
   // One checkerboard colour of one row: propagate the planes of the (other-coloured)
   // neighbours, then try random perturbations of the best plane.
-  void SweepRow(int y, int colour, int iter) {
+  void SweepRow(int y, int colour, int iter, bool fast) {
     static const int kNeighbours[8][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1},
                                           {-3, 0}, {3, 0}, {0, -3}, {0, 3}};
     const double depth_sigma = options_.depth_perturbation * std::pow(0.5, iter);
@@ -458,8 +545,8 @@ class ViewSolver {
           best_n = n;
         }
       };
-      for (const auto& off : kNeighbours) {
-        const int nx = x + off[0], ny = y + off[1];
+      for (int k = 0; k < (fast ? 4 : 8); ++k) {
+        const int nx = x + kNeighbours[k][0], ny = y + kNeighbours[k][1];
         if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
         const size_t j = Index(nx, ny);
         if (depth_[j] <= 0) continue;
@@ -471,8 +558,10 @@ class ViewSolver {
         consider(d, n);
       }
       Rng rng(HashSeed(options_.seed, i, iter, colour + 2));
-      const Eigen::Vector3d random_n = RandomNormal(&rng, ray);
-      consider(RandomDepth(&rng), random_n);
+      if (!fast) {
+        const Eigen::Vector3d random_n = RandomNormal(&rng, ray);
+        consider(RandomDepth(&rng), random_n);
+      }
       const double perturbed_d =
           best_d * (1.0 + depth_sigma * (2.0 * rng.Uniform() - 1.0));
       Eigen::Vector3d perturbed_n =
@@ -502,7 +591,9 @@ class ViewSolver {
   std::vector<float> padded_ref_;
   std::vector<int> offsets_;
   int num_samples_ = 0;
-  std::vector<float> ref_mean_, ref_std_;
+  std::vector<float> ref_mean_, ref_std_, ref_weight_sum_;
+  std::vector<float> spatial_weight_;  // per window sample, row by row
+  std::vector<float> colour_weight_;   // by |grey difference| * kColourTableSize
   std::vector<uint8_t> textured_;
   std::vector<double> depth_;
   std::vector<Eigen::Vector3d> normal_;
@@ -566,6 +657,8 @@ void PatchMatchOptions::Check() const {
           "num_coarse_levels must be in [0, 4]");
   Require(num_fine_iterations >= 1, s, "num_fine_iterations must be >= 1");
   Require(top_k >= 1, s, "top_k must be >= 1");
+  Require(std::isfinite(sigma_color) && std::isfinite(sigma_spatial), s,
+          "sigma_color and sigma_spatial must be finite");
   Require(min_texture_std >= 0 && std::isfinite(min_texture_std), s,
           "min_texture_std must be >= 0");
   Require(depth_perturbation > 0 && depth_perturbation < 1, s,
@@ -703,7 +796,7 @@ DepthNormalMap PatchMatchView(const std::vector<StereoView>& views, int ref,
   }
   ViewSolver solver(views, ref, sources, options, source_depths);
   solver.Initialize(init);
-  solver.Iterate(iterations, first_iteration);
+  solver.Iterate(iterations, first_iteration, init != nullptr);
   return solver.Result();
 }
 

@@ -33,6 +33,13 @@ struct PatchMatchOptions {
   // The per-pixel cost is the mean of the best `top_k` source costs (2 beat 1 and 3 on
   // the synthetic room: occluded sources drop out, one lucky source does not decide).
   int top_k = 2;
+  // Bilateral window weights (as COLMAP): a sample counts exp(-dist^2 / (2
+  // sigma_spatial^2)
+  // - grey_diff^2 / (2 sigma_color^2)) with dist and grey_diff to the centre pixel, so a
+  // window straddling an object edge is dominated by the centre's side. sigma_color <= 0:
+  // uniform weights; sigma_spatial <= 0: window_radius.
+  double sigma_color = 0.2;
+  double sigma_spatial = 0;
   // Pixels whose reference window has a grey standard deviation below this are
   // textureless: NCC says nothing there, so they get no depth.
   double min_texture_std = 0.01;
@@ -45,17 +52,28 @@ struct PatchMatchOptions {
   double geom_consistency_max_cost = 3.0;
   // Filter: a source confirms a pixel when its NCC >= filter_min_ncc, the triangulation
   // angle >= filter_min_triangulation_angle (degrees) and (geometric pass) the
-  // reprojection error <= filter_geom_consistency_max_cost pixels.
+  // reprojection error <= filter_geom_consistency_max_cost pixels. The angle is 1 degree
+  // (COLMAP: 3) because the forward-backward check already rejects what a narrow
+  // baseline gets wrong; on the synthetic room 3 degrees deleted 19% of textured pixels,
+  // most of them correct (1 degree: 8.5%, and more pixels within 1%).
   bool filter = true;
   double filter_min_ncc = 0.1;
-  double filter_min_triangulation_angle = 3.0;
+  double filter_min_triangulation_angle = 1.0;
   double filter_geom_consistency_max_cost = 1.0;
-  int filter_min_num_consistent = 2;
+  // One confirming source (COLMAP: 2): the parts of a view that only one source sees
+  // (image borders, the ends of a camera path) would otherwise all be deleted. On the
+  // synthetic room 2 (with an adaptive variant: at most the number of sources whose
+  // image holds the point) kept 1.3% fewer good pixels and deleted 15% instead of 8.6%.
+  int filter_min_num_consistent = 1;
   // Coarse-to-fine: solve at half resolution first (recursively, this many levels, while
   // the smaller side stays >= 64 pixels), then refine the upsampled planes with
   // num_fine_iterations at full resolution. Photometric pass only.
   int num_coarse_levels = 1;
   int num_fine_iterations = 2;
+  // Iterations that start from converged planes (finer level, geometric pass) propagate
+  // from the 4 nearest neighbours only and skip the random plane: about a third less
+  // work there.
+  bool fast_refinement = true;
   int num_threads = 0;  // <= 0: DefaultNumThreads()
   uint64_t seed = 0;
 
