@@ -288,6 +288,9 @@ TEST(PatchMatchStereoTest, CommandThroughTheFrontDoor) {
 // The synthetic room of src/fvs/synthetic (generated through the front door, so this test
 // needs no link to fvs_synthetic): >= 80% of textured pixels within 1% of the exact
 // depth, and COLMAP's own stereo_fusion turns our maps into points on the true surface.
+// 8 views (as the stereo brief asks: 8-10 at 320x240): the first and last view of the
+// path see a strip that no other view sees, which no stereo method can get right; with
+// 6 views those strips weigh a third more (78-79% within 1% there, middle views 86%).
 TEST(PatchMatchStereoTest, SyntheticSceneMeetsTheAccuracyTarget) {
   const std::string colmap = fvs::testing::FrontDoorBinary();
   if (!fs::exists(colmap)) GTEST_SKIP() << "front door not built: " << colmap;

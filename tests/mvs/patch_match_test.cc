@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "fvs/mvs/patch_match_stereo.h"
 #include "fvs/mvs/stereo_test_scene.h"
@@ -229,6 +230,12 @@ TEST(PatchMatchTest, BadInputThrowsError) {
   EXPECT_THROW(PatchMatchView(views, 0, {1}, bad), Error);
   bad = pm;
   bad.depth_perturbation = std::nan("");
+  EXPECT_THROW(bad.Check(), Error);
+  bad = pm;
+  bad.sigma_color = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(bad.Check(), Error);
+  bad = pm;
+  bad.sigma_spatial = std::nan("");
   EXPECT_THROW(bad.Check(), Error);
 }
 

@@ -46,6 +46,12 @@ int RunViewSynthesisStereo(int argc, char** argv) {
                      "NCC window radius (pixels)");
   options.AddDefault(p + "window_step", &pm.window_step, "NCC window sampling step");
   options.AddDefault(p + "num_iterations", &pm.num_iterations, "photometric iterations");
+  options.AddDefault(p + "sigma_color", &pm.sigma_color,
+                     "bilateral NCC weights: grey sigma (0 = uniform window)");
+  options.AddDefault(p + "sigma_spatial", &pm.sigma_spatial,
+                     "bilateral NCC weights: spatial sigma (0 = window_radius)");
+  options.AddDefault(p + "fast_refinement", &pm.fast_refinement,
+                     "refinement from converged planes: 4 neighbours, no random plane");
   options.AddDefault(p + "num_geometric_iterations", &pm.num_geometric_iterations,
                      "geometric-consistency iterations");
   options.AddDefault(p + "top_k", &pm.top_k, "cost = mean of the best k source costs");
