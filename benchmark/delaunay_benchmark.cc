@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "fvs/mvs/delaunay.h"
+#include "fvs/util/machine.h"
 #ifdef FVS_HAVE_CGAL
 #include "fvs/mvs/delaunay_scene.h"
 #endif
@@ -21,25 +22,6 @@
 #include "fvs/util/progress.h"
 
 namespace {
-
-std::string CpuModel() {
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(cpuinfo, line)) {
-    if (line.rfind("model name", 0) == 0) {
-      const size_t colon = line.find(':');
-      if (colon != std::string::npos) return line.substr(colon + 2);
-    }
-  }
-  return "unknown";
-}
-
-double ProcessCpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec +
-         1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
 
 // The machine's load: on a shared machine wall times grow with it, CPU times much less.
 std::string LoadAverage() {
@@ -84,7 +66,7 @@ int main(int argc, char** argv) {
   }
   try {
     std::printf("machine: %u hardware threads, CPU %s, load average %s\n",
-                std::thread::hardware_concurrency(), CpuModel().c_str(),
+                std::thread::hardware_concurrency(), fvs::CpuModelName().c_str(),
                 LoadAverage().c_str());
     fvs::Timer timer;
     const auto scene = fvs::mvs::MakeRoomScene(num_cameras, 640, 480);
@@ -104,9 +86,9 @@ int main(int argc, char** argv) {
         options.distance_sigma_factor, options.quality_regularization,
         options.num_threads);
     fvs::mvs::DelaunayMeshingStats stats;
-    const double cpu_before = ProcessCpuSeconds();
+    const double cpu_before = fvs::ProcessCpuSeconds();
     const auto mesh = fvs::mvs::DelaunayMeshing(cloud.input, options, &stats);
-    const double cpu_seconds = ProcessCpuSeconds() - cpu_before;
+    const double cpu_seconds = fvs::ProcessCpuSeconds() - cpu_before;
     std::printf("mesher: %s\n", stats.Summary().c_str());
     std::printf("mesher CPU time %.1f s (user + system, all threads); load average %s\n",
                 cpu_seconds, LoadAverage().c_str());

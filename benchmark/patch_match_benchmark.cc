@@ -32,27 +32,10 @@
 #include "fvs/mvs/stereo_test_scene.h"
 #include "fvs/synthetic/generate.h"
 #include "fvs/util/error.h"
+#include "fvs/util/machine.h"
 #include "fvs/util/progress.h"
 
 namespace {
-
-std::string CpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  }
-  return "unknown";
-}
-
-// User + system CPU seconds of this process (all threads): the machine is shared, so
-// wall time alone says little.
-double CpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec +
-         1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
 
 double LoadAverage() {
   double load[1] = {0};
@@ -120,7 +103,8 @@ int main(int argc, char** argv) {
                   .string()
             : keep;
     std::printf("machine: nproc %u, %s; stereo threads %d\n",
-                std::thread::hardware_concurrency(), CpuModel().c_str(), threads);
+                std::thread::hardware_concurrency(), fvs::CpuModelName().c_str(),
+                threads);
     std::printf("scene: %s, %d views, %dx%d, workspace %s\n", scene_kind.c_str(), views,
                 width, height, dir.c_str());
     fvs::Timer gen_timer;
@@ -145,10 +129,10 @@ int main(int argc, char** argv) {
     options.patch_match.num_threads = threads;
     options.overwrite = true;
     const double load_before = LoadAverage();
-    const double cpu_before = CpuSeconds();
+    const double cpu_before = fvs::ProcessCpuSeconds();
     const fvs::mvs::PatchMatchStereoSummary summary =
         fvs::mvs::RunPatchMatchStereo(dir, options);
-    const double cpu_seconds = CpuSeconds() - cpu_before;
+    const double cpu_seconds = fvs::ProcessCpuSeconds() - cpu_before;
     const int computed = std::max(1, summary.num_photometric_computed);
 
     const fvs::colmap::Reconstruction rec = fvs::colmap::ReadSparseModel(ws.SparseDir());

@@ -19,6 +19,7 @@
 
 #include "fvs/geometry/ply.h"
 #include "fvs/geometry/rasterizer.h"
+#include "fvs/util/machine.h"
 #include "fvs/util/parallel.h"
 #include "fvs/util/progress.h"
 
@@ -26,15 +27,6 @@ namespace {
 
 using fvs::PinholeCamera;
 using fvs::TriangleMesh;
-
-std::string CpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  }
-  return "unknown";
-}
 
 void Append(TriangleMesh* mesh, const TriangleMesh& part) {
   const int base = static_cast<int>(mesh->vertices.size());
@@ -139,14 +131,6 @@ PinholeCamera LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) 
   return c;
 }
 
-// CPU seconds of all threads of the process: on a machine shared with other jobs the wall
-// clock measures the neighbours as much as us, so both are printed.
-double ProcessCpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
 double LoadAverage() {
   std::ifstream in("/proc/loadavg");
   double load = 0;
@@ -178,7 +162,7 @@ int main(int argc, char** argv) {
   Append(&mesh, Room(12, 6, 24));                 // 6912 faces
   const int num_threads = threads > 0 ? threads : fvs::DefaultNumThreads();
   std::printf("machine: nproc %ld, CPU %s, threads used %d\n",
-              sysconf(_SC_NPROCESSORS_ONLN), CpuModel().c_str(), num_threads);
+              sysconf(_SC_NPROCESSORS_ONLN), fvs::CpuModelName().c_str(), num_threads);
   std::printf("mesh: %zu vertices, %zu faces; image 960x540\n", mesh.vertices.size(),
               mesh.faces.size());
 
@@ -199,11 +183,11 @@ int main(int argc, char** argv) {
   std::vector<fvs::Image> depths;
   for (const PinholeCamera& camera : cameras) {
     for (int r = 0; r < runs; ++r) {
-      const double cpu0 = ProcessCpuSeconds();
+      const double cpu0 = fvs::ProcessCpuSeconds();
       fvs::Timer timer;
       fvs::RasterResult result = fvs::Rasterize(mesh, camera, depth_only);
       depth_times.push_back(timer.Seconds());
-      depth_cpu.push_back(ProcessCpuSeconds() - cpu0);
+      depth_cpu.push_back(fvs::ProcessCpuSeconds() - cpu0);
       if (r == 0) depths.push_back(std::move(result.depth));
     }
     fvs::Timer timer;
@@ -248,16 +232,16 @@ int main(int argc, char** argv) {
   // PLY round trip of the same mesh (binary, float coordinates as COLMAP writes).
   const std::string ply_path =
       "/tmp/fvs_rasterizer_benchmark_" + std::to_string(getpid()) + ".ply";
-  double cpu = ProcessCpuSeconds();
+  double cpu = fvs::ProcessCpuSeconds();
   fvs::Timer timer;
   fvs::WritePlyMesh(ply_path, mesh);
   const double write_seconds = timer.Seconds();
-  const double write_cpu = ProcessCpuSeconds() - cpu;
-  cpu = ProcessCpuSeconds();
+  const double write_cpu = fvs::ProcessCpuSeconds() - cpu;
+  cpu = fvs::ProcessCpuSeconds();
   timer.Restart();
   const TriangleMesh back = fvs::ReadPlyMesh(ply_path);
   const double read_seconds = timer.Seconds();
-  const double read_cpu = ProcessCpuSeconds() - cpu;
+  const double read_cpu = fvs::ProcessCpuSeconds() - cpu;
   std::remove(ply_path.c_str());
 
   std::printf(

@@ -12,35 +12,14 @@
 #include <thread>
 #include <vector>
 
+#include "fvs/eval/metrics.h"
 #include "fvs/render/method.h"
 #include "fvs/scene/scene.h"
 #include "fvs/synthetic/render.h"
 #include "fvs/synthetic/synthetic_scene.h"
+#include "fvs/util/machine.h"
 #include "fvs/util/parallel.h"
 #include "fvs/util/progress.h"
-
-namespace {
-
-std::string CpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  }
-  return "unknown";
-}
-
-double Psnr(const fvs::Image& a, const fvs::Image& b) {
-  double se = 0;
-  for (size_t i = 0; i < a.data.size(); ++i) {
-    const double d = a.data[i] - b.data[i];
-    se += d * d;
-  }
-  const double mse = se / std::max<size_t>(1, a.data.size());
-  return mse > 0 ? 10 * std::log10(1.0 / mse) : 99.0;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   int num_views = 16, num_frames = 3, max_k = 8;
@@ -64,7 +43,7 @@ int main(int argc, char** argv) {
   }
   std::printf("machine: nproc %u, threads used %d, CPU %s\n",
               std::thread::hardware_concurrency(), fvs::DefaultNumThreads(),
-              CpuModel().c_str());
+              fvs::CpuModelName().c_str());
   std::printf(
       "scene: synthetic room, %d views, exact mesh as proxy; %d held-out frames\n",
       num_views, num_frames);
@@ -106,7 +85,10 @@ int main(int argc, char** argv) {
             target.camera = scene.view(held_out).camera;
             target.exclude_views = {held_out};
             const fvs::RenderResult r = renderer->Render(scene, target);
-            psnr += Psnr(r.color, photos[held_out]) / num_frames;
+            // The evaluation protocol: 8-bit prediction, as a saved PNG.
+            psnr +=
+                fvs::eval::Psnr(fvs::eval::QuantizeTo8Bit(r.color), photos[held_out]) /
+                num_frames;
             double covered = 0;
             for (float c : r.coverage.data) covered += c;
             coverage += covered / r.coverage.data.size() / num_frames;

@@ -41,7 +41,8 @@ TEST(Metrics, MatchScikitImageReference) {
 }
 
 TEST(Metrics, AnalyticValues) {
-  // Constant images: the contrast-structure term is C2 / C2 = 1, luminance is closed form.
+  // Constant images: the contrast-structure term is C2 / C2 = 1, luminance is closed
+  // form.
   const Image a(20, 20, 3, 0.2f), b(20, 20, 3, 0.6f);
   const double C1 = 1e-4;
   const double expected = (2 * 0.2 * 0.6 + C1) / (0.2 * 0.2 + 0.6 * 0.6 + C1);
@@ -54,7 +55,7 @@ TEST(Metrics, AnalyticValues) {
 TEST(Metrics, MaskRestrictsPixels) {
   Image a(20, 20, 1, 0.5f), b(20, 20, 1, 0.5f), mask(20, 20, 1, 0.0f);
   for (int y = 0; y < 20; ++y) {
-    for (int x = 10; x < 20; ++x) b.at(x, y) = 0.0f;  // right half wrong
+    for (int x = 10; x < 20; ++x) b.at(x, y) = 0.0f;    // right half wrong
     for (int x = 0; x < 10; ++x) mask.at(x, y) = 1.0f;  // left half counted
   }
   EXPECT_EQ(Psnr(a, b, &mask), kMaxPsnr);
@@ -65,8 +66,8 @@ TEST(Metrics, MaskRestrictsPixels) {
 
 TEST(Metrics, QuantizationRoundsLikeAPng) {
   Image a(2, 1, 1);
-  a.at(0, 0) = 0.5f;               // 127.5 -> 128
-  a.at(1, 0) = std::nanf("");      // never leaks
+  a.at(0, 0) = 0.5f;           // 127.5 -> 128
+  a.at(1, 0) = std::nanf("");  // never leaks
   const Image q = QuantizeTo8Bit(a);
   EXPECT_FLOAT_EQ(q.at(0, 0), 128.0f / 255.0f);
   EXPECT_FLOAT_EQ(q.at(1, 0), 0.0f);

@@ -11,7 +11,8 @@ namespace {
 
 std::string RunFrontDoor(const std::string& args, int* status) {
   std::string out;
-  *status = RunShell("QT_QPA_PLATFORM=offscreen '" + FrontDoorBinary() + "' " + args, &out);
+  *status =
+      RunShell("QT_QPA_PLATFORM=offscreen '" + FrontDoorBinary() + "' " + args, &out);
   return out;
 }
 
@@ -30,12 +31,12 @@ TEST(FrontDoor, HelpListsColmapCommandsThenOurs) {
 TEST(FrontDoor, ForwardsOtherCommandsToRealColmap) {
   TempDir dir;
   int status = -1;
-  // model_converter on an empty folder fails inside COLMAP: the exit code and COLMAP's own
-  // message come through unchanged.
+  // model_converter on an empty folder fails inside COLMAP: the exit code and COLMAP's
+  // own message come through unchanged.
   const std::string out =
-      RunFrontDoor("model_converter --input_path " + dir.path() + " --output_path " + dir.path() +
-              " --output_type TXT",
-          &status);
+      RunFrontDoor("model_converter --input_path " + dir.path() + " --output_path " +
+                       dir.path() + " --output_type TXT",
+                   &status);
   EXPECT_NE(status, 0);
   int help_status = -1;
   const std::string help = RunFrontDoor("model_converter -h", &help_status);
@@ -45,7 +46,8 @@ TEST(FrontDoor, ForwardsOtherCommandsToRealColmap) {
 
 TEST(FrontDoor, UnknownOptionOfOurCommandIsOneErrorLine) {
   int status = -1;
-  const std::string out = RunFrontDoor("view_synthesis_synthetic --no_such_option 1", &status);
+  const std::string out =
+      RunFrontDoor("view_synthesis_synthetic --no_such_option 1", &status);
   if (out.find("unknown command") != std::string::npos) GTEST_SKIP();
   EXPECT_EQ(status, 1);
   EXPECT_NE(out.find("ERROR: "), std::string::npos) << out;

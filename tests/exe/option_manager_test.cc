@@ -75,10 +75,10 @@ TEST(OptionManager, HelpReturnsFalseAndListsOptions) {
 
 TEST(OptionManager, BadInputThrowsOneLine) {
   const std::vector<std::vector<std::string>> bad = {
-      {"colmap", "c"},                                               // missing required
-      {"colmap", "c", "--workspace_path", "w", "--unknown", "1"},    // unknown option
-      {"colmap", "c", "--workspace_path"},                           // missing value
-      {"colmap", "c", "--workspace_path", "w", "--num_sources", "x"},// not an int
+      {"colmap", "c"},                                                 // missing required
+      {"colmap", "c", "--workspace_path", "w", "--unknown", "1"},      // unknown option
+      {"colmap", "c", "--workspace_path"},                             // missing value
+      {"colmap", "c", "--workspace_path", "w", "--num_sources", "x"},  // not an int
       {"colmap", "c", "--workspace_path", "w", "--num_sources", "99999999999"},
       {"colmap", "c", "--workspace_path", "w", "--Render.tolerance", "nan"},
       {"colmap", "c", "--workspace_path", "w", "--flag", "maybe"},

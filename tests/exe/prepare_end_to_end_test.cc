@@ -1,6 +1,6 @@
-// view_synthesis_prepare from photos, as a user runs it: through the front door, killed with
-// SIGKILL part-way, then run again. The rerun must finish the job without redoing a stage
-// that had completed, and a third run must skip everything.
+// view_synthesis_prepare from photos, as a user runs it: through the front door, killed
+// with SIGKILL part-way, then run again. The rerun must finish the job without redoing a
+// stage that had completed, and a third run must skip everything.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -27,7 +27,8 @@ std::set<std::string> StagesMatching(const std::string& log, const std::string& 
 
 TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
   TempDir dir;
-  const std::string colmap = "QT_QPA_PLATFORM=offscreen FVS_QUIET=1 '" + FrontDoorBinary() + "'";
+  const std::string colmap =
+      "QT_QPA_PLATFORM=offscreen FVS_QUIET=1 '" + FrontDoorBinary() + "'";
   std::string log;
   ASSERT_EQ(RunShell(colmap + " view_synthesis_synthetic --output_path " + dir / "scene" +
                          " --SyntheticScene.num_views 10 --SyntheticScene.width 320"
@@ -41,7 +42,8 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
   // SIGKILL part-way: 25 s is inside SfM or stereo on 2 cores.
   std::string killed_log;
   RunShell("timeout -s KILL 25 " + prepare, &killed_log);
-  const std::set<std::string> finished_before_kill = StagesMatching(killed_log, "done in");
+  const std::set<std::string> finished_before_kill =
+      StagesMatching(killed_log, "done in");
 
   std::string resumed_log;
   ASSERT_EQ(RunShell(prepare, &resumed_log), 0) << killed_log << resumed_log;
@@ -54,16 +56,17 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
   ASSERT_EQ(RunShell(prepare, &third_log), 0) << third_log;
   EXPECT_EQ(StagesMatching(third_log, "up to date").size(), 8u) << third_log;
 
-  // The workspace is a COLMAP dense workspace with a mesh; the held-out image is registered
-  // but has no depth map and is in no stereo config.
+  // The workspace is a COLMAP dense workspace with a mesh; the held-out image is
+  // registered but has no depth map and is in no stereo config.
   const auto rec = colmap::ReadSparseModel(dir / "ws/sparse");
   EXPECT_EQ(rec.images.size(), 10u);
   EXPECT_NE(rec.FindImageByName("frame_0009.png"), nullptr);
-  EXPECT_FALSE(std::filesystem::exists(
-      dir / "ws/stereo/depth_maps/frame_0009.png.geometric.bin"));
-  EXPECT_TRUE(std::filesystem::exists(
-      dir / "ws/stereo/depth_maps/frame_0000.png.geometric.bin"));
-  EXPECT_EQ(ReadTextFile(dir / "ws/stereo/fusion.cfg").find("frame_0009"), std::string::npos);
+  EXPECT_FALSE(
+      std::filesystem::exists(dir / "ws/stereo/depth_maps/frame_0009.png.geometric.bin"));
+  EXPECT_TRUE(
+      std::filesystem::exists(dir / "ws/stereo/depth_maps/frame_0000.png.geometric.bin"));
+  EXPECT_EQ(ReadTextFile(dir / "ws/stereo/fusion.cfg").find("frame_0009"),
+            std::string::npos);
   const TriangleMesh mesh = ReadPlyMesh(dir / "ws/meshed-delaunay.ply");
   EXPECT_GT(mesh.faces.size(), 1000u);
   EXPECT_TRUE(std::filesystem::exists(dir / "ws/fvs/depth/frame_0000.png.bin"));

@@ -32,10 +32,12 @@ TEST(PrepareStages, RecognisesVideoFrames) {
 
 TEST(PrepareStages, HoldoutListFromCommasOrFile) {
   EXPECT_TRUE(ParseHoldoutList("").empty());
-  EXPECT_EQ(ParseHoldoutList("a.jpg, b.jpg,,"), (std::set<std::string>{"a.jpg", "b.jpg"}));
+  EXPECT_EQ(ParseHoldoutList("a.jpg, b.jpg,,"),
+            (std::set<std::string>{"a.jpg", "b.jpg"}));
   testing::TempDir dir;
   testing::WriteTextFile(dir / "list.txt", "# targets\nx.png\n\n  y.png  \n");
-  EXPECT_EQ(ParseHoldoutList(dir / "list.txt"), (std::set<std::string>{"x.png", "y.png"}));
+  EXPECT_EQ(ParseHoldoutList(dir / "list.txt"),
+            (std::set<std::string>{"x.png", "y.png"}));
 }
 
 TEST(PrepareStages, ListImageFilesRejectsEmptyAndMissingFolders) {

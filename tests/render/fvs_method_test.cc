@@ -1,7 +1,7 @@
 // The network as a rendering method, with small random-weight models made here: finite,
 // deterministic output of the target's size, source features encoded once across targets,
-// and clear errors for missing or mismatched weights. (Image quality needs trained weights:
-// that is the training issue's and the evaluation's business.)
+// and clear errors for missing or mismatched weights. (Image quality needs trained
+// weights: that is the training issue's and the evaluation's business.)
 #include "fvs/render/fvs_method.h"
 
 #include <gtest/gtest.h>
@@ -66,12 +66,13 @@ TEST(FvsMethod, FiniteDeterministicAndCached) {
 TEST(FvsMethod, EveryVariantRendersFiniteImages) {
   testing::TempDir dir;
   const Scene scene = testing::MakeTestScene(4, 40, 32);
-  for (const std::string& variant : {"fvs", "fvs_nogru", "fvs_nomasks", "fvs_noinfdepth",
-                                     "fvs_single"}) {
+  for (const std::string& variant :
+       {"fvs", "fvs_nogru", "fvs_nomasks", "fvs_noinfdepth", "fvs_single"}) {
     RenderOptions options;
     options.num_sources = 2;
     options.model_path = SaveRandomModel(dir.path(), variant);
-    const RenderResult r = CreateMethod(variant, options)->Render(scene, HeldOutTarget(scene, 1));
+    const RenderResult r =
+        CreateMethod(variant, options)->Render(scene, HeldOutTarget(scene, 1));
     EXPECT_TRUE(testing::AllFinite(r.color)) << variant;
     EXPECT_EQ(r.color.width, 40) << variant;
   }

@@ -38,7 +38,8 @@ TEST(AtomicFile, ExceptionLeavesOldFileAndNoTemp) {
 }
 
 TEST(AtomicFile, UnwritableFolderIsAnError) {
-  EXPECT_THROW(WriteFileAtomic("/nonexistent_dir_fvs/x.txt", [](std::ostream&) {}), Error);
+  EXPECT_THROW(WriteFileAtomic("/nonexistent_dir_fvs/x.txt", [](std::ostream&) {}),
+               Error);
   EXPECT_THROW(ReadFileToString("/nonexistent_dir_fvs/x.txt"), Error);
 }
 

@@ -24,12 +24,15 @@ TEST(Manifest, UpToDateOnlyWhenInputsOptionsAndOutputsAgree) {
   m.Save();
 
   Manifest reloaded = Manifest::Load(dir / "manifest.json");
-  EXPECT_TRUE(reloaded.IsUpToDate("stage", Manifest::Fingerprint({input}, "opt=1"), {output}));
+  EXPECT_TRUE(
+      reloaded.IsUpToDate("stage", Manifest::Fingerprint({input}, "opt=1"), {output}));
   // Other options.
-  EXPECT_FALSE(reloaded.IsUpToDate("stage", Manifest::Fingerprint({input}, "opt=2"), {output}));
+  EXPECT_FALSE(
+      reloaded.IsUpToDate("stage", Manifest::Fingerprint({input}, "opt=2"), {output}));
   // Changed input (size changes, so mtime resolution does not matter).
   testing::WriteTextFile(input, "aa");
-  EXPECT_FALSE(reloaded.IsUpToDate("stage", Manifest::Fingerprint({input}, "opt=1"), {output}));
+  EXPECT_FALSE(
+      reloaded.IsUpToDate("stage", Manifest::Fingerprint({input}, "opt=1"), {output}));
   // Missing output.
   testing::WriteTextFile(input, "a");
   const std::string f2 = Manifest::Fingerprint({input}, "opt=1");

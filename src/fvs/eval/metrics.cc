@@ -21,7 +21,8 @@ void CheckSameSize(const Image& a, const Image& b, const Image* mask, const char
                           std::to_string(b.height) + "x" + std::to_string(b.channels));
   }
   if (a.empty()) throw Error(what, "empty image");
-  if (mask && (mask->width != a.width || mask->height != a.height || mask->channels != 1)) {
+  if (mask &&
+      (mask->width != a.width || mask->height != a.height || mask->channels != 1)) {
     throw Error(what, "mask size differs from the images");
   }
 }
@@ -45,7 +46,8 @@ std::vector<double> FilterValid(const std::vector<double>& in, int w, int h,
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < ow; ++x) {
       double s = 0;
-      for (int i = 0; i <= 2 * kRadius; ++i) s += k[i] * in[static_cast<size_t>(y) * w + x + i];
+      for (int i = 0; i <= 2 * kRadius; ++i)
+        s += k[i] * in[static_cast<size_t>(y) * w + x + i];
       tmp[static_cast<size_t>(y) * ow + x] = s;
     }
   }
@@ -53,7 +55,8 @@ std::vector<double> FilterValid(const std::vector<double>& in, int w, int h,
   for (int y = 0; y < oh; ++y) {
     for (int x = 0; x < ow; ++x) {
       double s = 0;
-      for (int i = 0; i <= 2 * kRadius; ++i) s += k[i] * tmp[static_cast<size_t>(y + i) * ow + x];
+      for (int i = 0; i <= 2 * kRadius; ++i)
+        s += k[i] * tmp[static_cast<size_t>(y + i) * ow + x];
       out[static_cast<size_t>(y) * ow + x] = s;
     }
   }

@@ -1,6 +1,6 @@
-// Our `view_synthesis*` commands. Each lives in src/fvs/exe/<name>_command.cc and registers
-// itself with FVS_REGISTER_COMMAND; the front door (main.cc) runs ours and execs the real
-// COLMAP for everything else.
+// Our `view_synthesis*` commands. Each lives in src/fvs/exe/<name>_command.cc and
+// registers itself with FVS_REGISTER_COMMAND; the front door (main.cc) runs ours and
+// execs the real COLMAP for everything else.
 #pragma once
 
 #include <string>
@@ -27,15 +27,16 @@ struct CommandRegistrar {
   CommandRegistrar(const char* name, const char* description, CommandFunction function);
 };
 
-// Runs a registered command as the front door would (exceptions turned into one error line
-// on stderr and exit code 1). For tests and for the GUI.
+// Runs a registered command as the front door would (exceptions turned into one error
+// line on stderr and exit code 1). For tests and for the GUI.
 int RunCommand(int argc, char** argv);
 
 }  // namespace fvs
 
 #define FVS_REGISTER_COMMAND_CONCAT_(a, b) a##b
-#define FVS_REGISTER_COMMAND_NAME_(line) FVS_REGISTER_COMMAND_CONCAT_(fvs_command_registrar_, line)
+#define FVS_REGISTER_COMMAND_NAME_(line) \
+  FVS_REGISTER_COMMAND_CONCAT_(fvs_command_registrar_, line)
 // Works with qualified function names too: the registrar is named after the line.
-#define FVS_REGISTER_COMMAND(name, description, function)                 \
-  static ::fvs::CommandRegistrar FVS_REGISTER_COMMAND_NAME_(__LINE__)( \
-      name, description, function)
+#define FVS_REGISTER_COMMAND(name, description, function)                                \
+  static ::fvs::CommandRegistrar FVS_REGISTER_COMMAND_NAME_(__LINE__)(name, description, \
+                                                                      function)

@@ -1,5 +1,6 @@
-// The `colmap` front door: runs our view_synthesis* commands itself and execs the real COLMAP
-// for every other command with the same arguments, so one `colmap` on the PATH does both.
+// The `colmap` front door: runs our view_synthesis* commands itself and execs the real
+// COLMAP for every other command with the same arguments, so one `colmap` on the PATH
+// does both.
 #include <unistd.h>
 
 #include <cerrno>
@@ -37,8 +38,9 @@ int PrintHelp(const std::string& real_colmap, const std::string& help_arg) {
       ::pclose(pipe);
     }
   } else {
-    std::cout << "(no COLMAP executable found: only the colmap-fvs commands are available; "
-                 "install colmap or set FVS_COLMAP_BIN)\n";
+    std::cout
+        << "(no COLMAP executable found: only the colmap-fvs commands are available; "
+           "install colmap or set FVS_COLMAP_BIN)\n";
   }
   PrintOurCommands();
   return 0;
@@ -59,15 +61,17 @@ int main(int argc, char** argv) {
     return PrintHelp(real_colmap, command.empty() ? "help" : command);
   }
   if (real_colmap.empty()) {
-    std::cerr << "ERROR: colmap " << command
-              << ": not a colmap-fvs command, and no COLMAP executable was found to run it "
-                 "(install colmap or set FVS_COLMAP_BIN)\n";
+    std::cerr
+        << "ERROR: colmap " << command
+        << ": not a colmap-fvs command, and no COLMAP executable was found to run it "
+           "(install colmap or set FVS_COLMAP_BIN)\n";
     return 1;
   }
   std::vector<char*> args(argv, argv + argc);
   args[0] = real_colmap.data();
   args.push_back(nullptr);
   ::execv(real_colmap.c_str(), args.data());
-  std::cerr << "ERROR: cannot run " << real_colmap << ": " << std::strerror(errno) << "\n";
+  std::cerr << "ERROR: cannot run " << real_colmap << ": " << std::strerror(errno)
+            << "\n";
   return 1;
 }

@@ -82,7 +82,8 @@ std::string OptionManager::ValueString(const Option& option) const {
       s << *static_cast<int*>(option.target);
       break;
     case Option::Kind::kDouble: {
-      // Shortest text that reads back as the same double ("0.05", not 0.05000000000000001).
+      // Shortest text that reads back as the same double ("0.05", not
+      // 0.05000000000000001).
       char buffer[64];
       const auto r = std::to_chars(buffer, buffer + sizeof(buffer),
                                    *static_cast<double*>(option.target));
@@ -98,7 +99,8 @@ std::string OptionManager::ValueString(const Option& option) const {
 
 std::string OptionManager::Usage() const {
   std::ostringstream s;
-  s << "Usage: colmap " << command_ << " [options]\n\n" << description_ << "\n\nOptions:\n";
+  s << "Usage: colmap " << command_ << " [options]\n\n"
+    << description_ << "\n\nOptions:\n";
   s << "  -h [ --help ]\n";
   for (const Option& o : options_) {
     s << "  --" << o.name;
@@ -133,8 +135,8 @@ bool OptionManager::Parse(int argc, char** argv, int first) {
   for (int i = first; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg.size() < 2 || arg[0] != '-') {
-      throw Error("colmap " + command_, "unexpected argument '" + arg +
-                                            "' (options are --name value; see -h)");
+      throw Error("colmap " + command_,
+                  "unexpected argument '" + arg + "' (options are --name value; see -h)");
     }
     std::string name = StripDashes(arg);
     std::string value;
@@ -167,8 +169,10 @@ bool OptionManager::Parse(int argc, char** argv, int first) {
         char* end = nullptr;
         errno = 0;
         const long v = std::strtol(value.c_str(), &end, 10);
-        if (value.empty() || *end != '\0' || errno != 0 || v < INT32_MIN || v > INT32_MAX) {
-          throw Error(where, "option --" + name + " expects an integer, got '" + value + "'");
+        if (value.empty() || *end != '\0' || errno != 0 || v < INT32_MIN ||
+            v > INT32_MAX) {
+          throw Error(where,
+                      "option --" + name + " expects an integer, got '" + value + "'");
         }
         *static_cast<int*>(option->target) = static_cast<int>(v);
         break;
@@ -177,8 +181,8 @@ bool OptionManager::Parse(int argc, char** argv, int first) {
         char* end = nullptr;
         const double v = std::strtod(value.c_str(), &end);
         if (value.empty() || *end != '\0' || !std::isfinite(v)) {
-          throw Error(where,
-                      "option --" + name + " expects a finite number, got '" + value + "'");
+          throw Error(where, "option --" + name + " expects a finite number, got '" +
+                                 value + "'");
         }
         *static_cast<double*>(option->target) = v;
         break;
@@ -186,8 +190,8 @@ bool OptionManager::Parse(int argc, char** argv, int first) {
       case Option::Kind::kBool: {
         bool v = false;
         if (!ParseBool(value, &v)) {
-          throw Error(where, "option --" + name + " expects 0/1/true/false, got '" +
-                                 value + "'");
+          throw Error(
+              where, "option --" + name + " expects 0/1/true/false, got '" + value + "'");
         }
         *static_cast<bool*>(option->target) = v;
         break;

@@ -27,7 +27,8 @@ namespace {
 
 const char* kWho = "colmap view_synthesis_prepare";
 
-// FNV-1a: a stable digest for chaining fingerprints (std::hash is not stable across builds).
+// FNV-1a: a stable digest for chaining fingerprints (std::hash is not stable across
+// builds).
 std::string Digest(const std::string& text) {
   uint64_t h = 1469598103934665603ull;
   for (unsigned char c : text) {
@@ -44,9 +45,9 @@ void RemoveAll(const std::string& path) {
   fs::remove_all(path, ec);
 }
 
-// Replaces `to` by `from` (both folders or files) as atomically as the file system allows:
-// the old output is moved aside first, so at every instant either the old or the new one is
-// complete.
+// Replaces `to` by `from` (both folders or files) as atomically as the file system
+// allows: the old output is moved aside first, so at every instant either the old or the
+// new one is complete.
 void MoveIntoPlace(const std::string& from, const std::string& to) {
   std::error_code ec;
   const std::string old = to + ".old-fvs";
@@ -75,7 +76,8 @@ void RunOurCommand(const std::string& command, const std::vector<std::string>& o
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   const int status = info->function(static_cast<int>(args.size()), argv.data());
-  if (status != 0) throw Error(kWho, command + " failed (exit " + std::to_string(status) + ")");
+  if (status != 0)
+    throw Error(kWho, command + " failed (exit " + std::to_string(status) + ")");
 }
 
 struct StageRunner {
@@ -149,13 +151,15 @@ std::vector<std::string> ListImageFiles(const std::string& folder) {
     }
   }
   std::sort(names.begin(), names.end());
-  if (names.empty()) throw Error(folder, "no images (.jpg, .png, .tif, ...) in this folder");
+  if (names.empty())
+    throw Error(folder, "no images (.jpg, .png, .tif, ...) in this folder");
   return names;
 }
 
 bool LooksLikeVideoFrames(const std::vector<std::string>& names) {
   if (names.size() < 10) return false;
-  // Strip the extension and the trailing digits: all the same prefix, numbers consecutive.
+  // Strip the extension and the trailing digits: all the same prefix, numbers
+  // consecutive.
   std::string prefix;
   long last = -1;
   int consecutive = 0;
@@ -241,12 +245,10 @@ void RunPrepareStages(const PrepareContext& c) {
               : images.size() > 150        ? "sequential"
                                            : "exhaustive";
   }
-  const bool builtin_stereo =
-      c.stereo_backend == "builtin" ||
-      (c.stereo_backend == "auto" && !colmap_caps.has_cuda);
-  const bool builtin_mesher =
-      c.mesher_backend == "builtin" ||
-      (c.mesher_backend == "auto" && !colmap_caps.has_cgal);
+  const bool builtin_stereo = c.stereo_backend == "builtin" ||
+                              (c.stereo_backend == "auto" && !colmap_caps.has_cuda);
+  const bool builtin_mesher = c.mesher_backend == "builtin" ||
+                              (c.mesher_backend == "auto" && !colmap_caps.has_cgal);
   if (c.stereo_backend == "colmap" && !colmap_caps.has_cuda) {
     throw Error(kWho, "--Stereo.backend colmap needs a COLMAP built with CUDA; " +
                           colmap_caps.executable + " has none (use builtin or auto)");
@@ -263,21 +265,21 @@ void RunPrepareStages(const PrepareContext& c) {
   stages.total = 8;
   const std::string gpu = colmap_caps.has_cuda ? "1" : "0";
 
-  stages.Run("feature_extraction", {c.image_path},
-             c.camera_model + " single=" + std::to_string(c.single_camera) +
-                 " size=" + std::to_string(c.max_image_size),
-             {database}, [&] {
-               // A database left by a killed extraction is incomplete: start over.
-               const std::string tmp_db = tmp_dir + "/database.db";
-               colmap::RunColmap(
-                   {"feature_extractor", "--database_path", tmp_db, "--image_path",
-                    c.image_path, "--ImageReader.camera_model", c.camera_model,
-                    "--ImageReader.single_camera", c.single_camera ? "1" : "0",
-                    "--SiftExtraction.use_gpu", gpu, "--SiftExtraction.max_image_size",
-                    std::to_string(c.max_image_size), "--SiftExtraction.num_threads",
-                    threads});
-               MoveIntoPlace(tmp_db, database);
-             });
+  stages.Run(
+      "feature_extraction", {c.image_path},
+      c.camera_model + " single=" + std::to_string(c.single_camera) +
+          " size=" + std::to_string(c.max_image_size),
+      {database}, [&] {
+        // A database left by a killed extraction is incomplete: start over.
+        const std::string tmp_db = tmp_dir + "/database.db";
+        colmap::RunColmap(
+            {"feature_extractor", "--database_path", tmp_db, "--image_path", c.image_path,
+             "--ImageReader.camera_model", c.camera_model, "--ImageReader.single_camera",
+             c.single_camera ? "1" : "0", "--SiftExtraction.use_gpu", gpu,
+             "--SiftExtraction.max_image_size", std::to_string(c.max_image_size),
+             "--SiftExtraction.num_threads", threads});
+        MoveIntoPlace(tmp_db, database);
+      });
 
   stages.Run("matching", {}, matcher, {database}, [&] {
     // Matching writes into the database: work on a copy, so a kill leaves the extracted
@@ -318,8 +320,8 @@ void RunPrepareStages(const PrepareContext& c) {
     MoveIntoPlace(best, sfm_model);
   });
 
-  stages.Run("undistortion", {}, "size=" + std::to_string(c.max_image_size) + " holdout=" +
-                                     holdout_list,
+  stages.Run("undistortion", {},
+             "size=" + std::to_string(c.max_image_size) + " holdout=" + holdout_list,
              {ws.ImagesDir(), ws.SparseDir()}, [&] {
                const std::string out = tmp_dir + "/undistorted";
                colmap::CreateDirectories(out);
@@ -331,8 +333,8 @@ void RunPrepareStages(const PrepareContext& c) {
                    colmap::ReadSparseModel(out + "/sparse");
                for (const std::string& h : c.holdout) {
                  if (rec.FindImageByName(h) == nullptr) {
-                   throw Error(c.image_path, "holdout image '" + h +
-                                                 "' was not registered by SfM");
+                   throw Error(c.image_path,
+                               "holdout image '" + h + "' was not registered by SfM");
                  }
                }
                colmap::CreateDirectories(ws.StereoDir());
@@ -345,26 +347,27 @@ void RunPrepareStages(const PrepareContext& c) {
              });
 
   const std::string depth_dir = ws.StereoDir() + "/depth_maps";
-  stages.Run("stereo", {}, std::string(builtin_stereo ? "builtin" : "colmap") +
-                               " size=" + std::to_string(c.stereo_max_image_size),
-             {depth_dir}, [&] {
-               if (builtin_stereo) {
-                 std::vector<std::string> args = {"--workspace_path", c.workspace_path};
-                 if (c.stereo_max_image_size > 0) {
-                   args.push_back("--PatchMatchStereo.max_image_size");
-                   args.push_back(std::to_string(c.stereo_max_image_size));
-                 }
-                 RunOurCommand("view_synthesis_stereo", args);
-               } else {
-                 colmap::RunColmap({"patch_match_stereo", "--workspace_path",
-                                    c.workspace_path, "--workspace_format", "COLMAP",
-                                    "--PatchMatchStereo.geom_consistency", "1",
-                                    "--PatchMatchStereo.max_image_size",
-                                    std::to_string(c.stereo_max_image_size > 0
-                                                       ? c.stereo_max_image_size
-                                                       : -1)});
-               }
-             });
+  stages.Run(
+      "stereo", {},
+      std::string(builtin_stereo ? "builtin" : "colmap") +
+          " size=" + std::to_string(c.stereo_max_image_size),
+      {depth_dir}, [&] {
+        if (builtin_stereo) {
+          std::vector<std::string> args = {"--workspace_path", c.workspace_path};
+          if (c.stereo_max_image_size > 0) {
+            args.push_back("--PatchMatchStereo.max_image_size");
+            args.push_back(std::to_string(c.stereo_max_image_size));
+          }
+          RunOurCommand("view_synthesis_stereo", args);
+        } else {
+          colmap::RunColmap(
+              {"patch_match_stereo", "--workspace_path", c.workspace_path,
+               "--workspace_format", "COLMAP", "--PatchMatchStereo.geom_consistency", "1",
+               "--PatchMatchStereo.max_image_size",
+               std::to_string(c.stereo_max_image_size > 0 ? c.stereo_max_image_size
+                                                          : -1)});
+        }
+      });
 
   stages.Run("fusion", {}, "", {ws.FusedPath(), ws.FusedVisPath()}, [&] {
     const std::string out = tmp_dir + "/fused.ply";
@@ -373,25 +376,25 @@ void RunPrepareStages(const PrepareContext& c) {
                        "--output_path", out, "--StereoFusion.num_threads", threads});
     std::error_code ec;
     if (!fs::exists(out, ec) || fs::file_size(out, ec) < 300) {
-      throw Error(ws.FusedPath(), "stereo fusion produced no points (the depth maps are "
-                                  "empty: too little texture or overlap?)");
+      throw Error(ws.FusedPath(),
+                  "stereo fusion produced no points (the depth maps are "
+                  "empty: too little texture or overlap?)");
     }
     MoveIntoPlace(out + ".vis", ws.FusedVisPath());
     MoveIntoPlace(out, ws.FusedPath());
   });
 
-  stages.Run("meshing", {}, builtin_mesher ? "builtin" : "colmap", {ws.DelaunayMeshPath()},
-             [&] {
-               if (builtin_mesher) {
-                 RunOurCommand("view_synthesis_mesher",
-                               {"--workspace_path", c.workspace_path});
-               } else {
-                 const std::string out = tmp_dir + "/meshed-delaunay.ply";
-                 colmap::RunColmap({"delaunay_mesher", "--input_path", c.workspace_path,
-                                    "--input_type", "dense", "--output_path", out});
-                 MoveIntoPlace(out, ws.DelaunayMeshPath());
-               }
-             });
+  stages.Run(
+      "meshing", {}, builtin_mesher ? "builtin" : "colmap", {ws.DelaunayMeshPath()}, [&] {
+        if (builtin_mesher) {
+          RunOurCommand("view_synthesis_mesher", {"--workspace_path", c.workspace_path});
+        } else {
+          const std::string out = tmp_dir + "/meshed-delaunay.ply";
+          colmap::RunColmap({"delaunay_mesher", "--input_path", c.workspace_path,
+                             "--input_type", "dense", "--output_path", out});
+          MoveIntoPlace(out, ws.DelaunayMeshPath());
+        }
+      });
 
   stages.Run("depth_cache", {}, "", {ws.FvsDir() + "/depth"}, [&] {
     RunOurCommand("view_synthesis_depth_cache", {"--workspace_path", c.workspace_path});

@@ -30,9 +30,9 @@ std::vector<std::string> ListImageFiles(const std::string& folder);
 // True when names look like frames of a video: a common prefix and consecutive numbers.
 bool LooksLikeVideoFrames(const std::vector<std::string>& names);
 
-// Writes stereo/patch-match.cfg and stereo/fusion.cfg listing the non-holdout images, each
-// with explicit sources (the images sharing most sparse points, holdouts excluded), so no
-// evaluation target leaks into the geometry.
+// Writes stereo/patch-match.cfg and stereo/fusion.cfg listing the non-holdout images,
+// each with explicit sources (the images sharing most sparse points, holdouts excluded),
+// so no evaluation target leaks into the geometry.
 void WriteStereoConfigs(const std::string& workspace_path,
                         const std::set<std::string>& holdout, int max_sources = 20);
 

@@ -9,22 +9,11 @@
 #include "fvs/exe/option_manager.h"
 #include "fvs/net/net.h"
 #include "fvs/util/error.h"
+#include "fvs/util/machine.h"
 #include "fvs/util/string_util.h"
 
 namespace fvs {
 namespace {
-
-std::string CpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (StartsWith(line, "model name")) {
-      const size_t colon = line.find(':');
-      if (colon != std::string::npos) return TrimString(line.substr(colon + 1));
-    }
-  }
-  return "unknown CPU";
-}
 
 int RunViewSynthesisModelInfo(int argc, char** argv) {
   std::string model = "all";
@@ -53,7 +42,8 @@ int RunViewSynthesisModelInfo(int argc, char** argv) {
 
   ConfigureTorchThreads();
   std::cout << "machine: " << std::thread::hardware_concurrency() << " cores (nproc), "
-            << CpuModel() << ", LibTorch threads " << torch::get_num_threads() << "\n";
+            << CpuModelName() << ", LibTorch threads " << torch::get_num_threads()
+            << "\n";
 
   std::vector<std::pair<ModelConfig, FvsNet>> nets;
   if (!weights.empty()) {

@@ -1,12 +1,12 @@
 // colmap view_synthesis_prepare --image_path P --workspace_path W
 //
-// Photos -> ready scene: feature extraction, matching, mapping, undistortion (COLMAP), dense
-// stereo (COLMAP's when it has CUDA, else ours), fusion (COLMAP), meshing (COLMAP's when it
-// has CGAL, else ours), source depth cache. Each stage records a fingerprint of its inputs
-// and options in W/fvs/manifest.json and is skipped when that is unchanged and its outputs
-// exist. Fingerprints chain (a stage's includes the one before it), so changing an early
-// stage re-runs everything after it. Stages write into W/fvs/tmp/ and rename into place, so
-// kill -9 at any point loses at most the stage that was running.
+// Photos -> ready scene: feature extraction, matching, mapping, undistortion (COLMAP),
+// dense stereo (COLMAP's when it has CUDA, else ours), fusion (COLMAP), meshing (COLMAP's
+// when it has CGAL, else ours), source depth cache. Each stage records a fingerprint of
+// its inputs and options in W/fvs/manifest.json and is skipped when that is unchanged and
+// its outputs exist. Fingerprints chain (a stage's includes the one before it), so
+// changing an early stage re-runs everything after it. Stages write into W/fvs/tmp/ and
+// rename into place, so kill -9 at any point loses at most the stage that was running.
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -39,17 +39,18 @@ struct PrepareOptions {
   std::string matcher = "auto";  // auto | exhaustive | sequential
   std::string camera_model = "SIMPLE_RADIAL";
   bool single_camera = true;
-  int max_image_size = 1600;       // SIFT and undistortion
+  int max_image_size = 1600;            // SIFT and undistortion
   std::string stereo_backend = "auto";  // auto | colmap | builtin
   std::string mesher_backend = "auto";  // auto | colmap | builtin
-  int stereo_max_image_size = 0;   // 0 = full undistorted size
-  std::string holdout_images;      // file with one image name per line, or comma list
+  int stereo_max_image_size = 0;        // 0 = full undistorted size
+  std::string holdout_images;  // file with one image name per line, or comma list
   int num_threads = -1;
 
   void Check() const {
     const std::string who = "colmap view_synthesis_prepare";
-    Require(matcher == "auto" || matcher == "exhaustive" || matcher == "sequential", who,
-            "--Matching.type must be auto, exhaustive or sequential, not '" + matcher + "'");
+    Require(
+        matcher == "auto" || matcher == "exhaustive" || matcher == "sequential", who,
+        "--Matching.type must be auto, exhaustive or sequential, not '" + matcher + "'");
     Require(stereo_backend == "auto" || stereo_backend == "colmap" ||
                 stereo_backend == "builtin",
             who, "--Stereo.backend must be auto, colmap or builtin");
@@ -63,10 +64,11 @@ struct PrepareOptions {
 
 int RunPrepare(int argc, char** argv) {
   PrepareOptions o;
-  OptionManager options("view_synthesis_prepare",
-                        "Photos to a ready view-synthesis scene: SfM, undistortion, dense "
-                        "stereo, fusion, meshing, source depth cache. Finished stages are "
-                        "skipped; a killed run resumes.");
+  OptionManager options(
+      "view_synthesis_prepare",
+      "Photos to a ready view-synthesis scene: SfM, undistortion, dense "
+      "stereo, fusion, meshing, source depth cache. Finished stages are "
+      "skipped; a killed run resumes.");
   options.AddRequired("image_path", &o.image_path, "folder of the input photos");
   options.AddRequired("workspace_path", &o.workspace_path, "output dense workspace");
   options.AddDefault("Matching.type", &o.matcher,
@@ -83,9 +85,10 @@ int RunPrepare(int argc, char** argv) {
                      "longest side for stereo (0 = undistorted size)");
   options.AddDefault("Mesher.backend", &o.mesher_backend,
                      "auto (COLMAP when it has CGAL), colmap, builtin");
-  options.AddDefault("holdout_images", &o.holdout_images,
-                     "images registered by SfM but kept out of stereo, fusion and meshing: "
-                     "a file with one name per line, or a comma-separated list");
+  options.AddDefault(
+      "holdout_images", &o.holdout_images,
+      "images registered by SfM but kept out of stereo, fusion and meshing: "
+      "a file with one name per line, or a comma-separated list");
   options.AddDefault("num_threads", &o.num_threads, "-1 = all cores");
   if (!options.Parse(argc, argv)) return 0;
   o.Check();

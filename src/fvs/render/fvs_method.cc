@@ -24,10 +24,12 @@ torch::Tensor ToTensor(const Image& image) {
 }
 
 Image ToImage(const torch::Tensor& chw) {
-  const torch::Tensor hwc = chw.squeeze(0).permute({1, 2, 0}).contiguous().to(torch::kCPU);
+  const torch::Tensor hwc =
+      chw.squeeze(0).permute({1, 2, 0}).contiguous().to(torch::kCPU);
   Image image(static_cast<int>(hwc.size(1)), static_cast<int>(hwc.size(0)),
               static_cast<int>(hwc.size(2)));
-  std::memcpy(image.data.data(), hwc.data_ptr<float>(), image.data.size() * sizeof(float));
+  std::memcpy(image.data.data(), hwc.data_ptr<float>(),
+              image.data.size() * sizeof(float));
   return image;
 }
 
@@ -59,9 +61,9 @@ class FvsMethod : public Method {
     for (int i = 0; i < k; ++i) {
       const int view = prepared.sources[i].view_index;
       const torch::Tensor& features = Features(scene, view);
-      const Image grid = GridSampleCoordinates(prepared.warps[i],
-                                               scene.view(view).camera.width,
-                                               scene.view(view).camera.height);
+      const Image grid =
+          GridSampleCoordinates(prepared.warps[i], scene.view(view).camera.width,
+                                scene.view(view).camera.height);
       const torch::Tensor grid_t = ToTensor(grid).permute({0, 2, 3, 1});  // [1,H,W,2]
       warped.push_back(WarpFeatures(features, grid_t));
       valid_warp.push_back(ToTensor(prepared.warps[i].valid_warp));

@@ -1,7 +1,7 @@
-// The network as a rendering method (`--method fvs`, or a variant name such as `fvs_fast`):
-// the shared geometric front end (PrepareTarget), then the sources' features encoded once
-// and cached across targets, warped into the target with grid_sample, blended by the
-// recurrent network. No torch in this header.
+// The network as a rendering method (`--method fvs`, or a variant name such as
+// `fvs_fast`): the shared geometric front end (PrepareTarget), then the sources' features
+// encoded once and cached across targets, warped into the target with grid_sample,
+// blended by the recurrent network. No torch in this header.
 #pragma once
 
 #include <memory>

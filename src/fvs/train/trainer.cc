@@ -16,6 +16,7 @@
 
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
+#include "fvs/util/machine.h"
 #include "fvs/util/parallel.h"
 #include "fvs/util/progress.h"
 #include "fvs/util/string_util.h"
@@ -55,18 +56,6 @@ std::vector<PackedScene> LoadScenes(const std::string& list, int min_views, int 
     scenes.push_back(std::move(s));
   }
   return scenes;
-}
-
-std::string CpuModel() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    if (StartsWith(line, "model name")) {
-      const size_t colon = line.find(':');
-      if (colon != std::string::npos) return TrimString(line.substr(colon + 1));
-    }
-  }
-  return "unknown CPU";
 }
 
 std::string FormatDuration(double seconds) {
@@ -247,7 +236,7 @@ std::string Trainer::HardwareDescription() const {
   } else {
     s << "CPU, " << torch::get_num_threads() << " LibTorch threads, ";
   }
-  s << std::thread::hardware_concurrency() << " cores, " << CpuModel();
+  s << std::thread::hardware_concurrency() << " cores, " << CpuModelName();
   return s.str();
 }
 

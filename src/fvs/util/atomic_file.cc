@@ -30,8 +30,8 @@ AtomicFile::AtomicFile(const std::string& path)
     : path_(path), temp_path_(TempPathFor(path)) {
   stream_.open(temp_path_, std::ios::binary | std::ios::trunc);
   if (!stream_) {
-    throw Error(path, std::string("cannot open for writing (") +
-                          std::strerror(errno) + ")");
+    throw Error(path,
+                std::string("cannot open for writing (") + std::strerror(errno) + ")");
   }
 }
 

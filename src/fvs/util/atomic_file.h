@@ -1,5 +1,6 @@
-// Writing files so that a killed run never leaves a half-written file that a later run trusts:
-// everything is written to "<path>.tmp-<pid>" and renamed over <path> on Commit().
+// Writing files so that a killed run never leaves a half-written file that a later run
+// trusts: everything is written to "<path>.tmp-<pid>" and renamed over <path> on
+// Commit().
 #pragma once
 
 #include <fstream>
@@ -21,7 +22,8 @@ class AtomicFile {
   const std::string& path() const { return path_; }
   const std::string& temp_path() const { return temp_path_; }
 
-  // Flushes, checks the stream (disk full shows here), closes and renames. Throws fvs::Error.
+  // Flushes, checks the stream (disk full shows here), closes and renames. Throws
+  // fvs::Error.
   void Commit();
 
  private:
@@ -36,7 +38,8 @@ void WriteFileAtomic(const std::string& path,
                      const std::function<void(std::ostream&)>& write);
 
 // Temporary path beside `path` for writers that need a file name rather than a stream (an
-// external library, say); rename it with CommitTempFile. Removed by RemoveTempFile on failure.
+// external library, say); rename it with CommitTempFile. Removed by RemoveTempFile on
+// failure.
 std::string TempPathFor(const std::string& path);
 void CommitTempFile(const std::string& temp_path, const std::string& path);
 

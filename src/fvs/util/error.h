@@ -1,6 +1,6 @@
 // Errors that reach the user as one line: "<file or subject>: <what is wrong>".
-// Every stage throws fvs::Error on bad input; the commands catch it, print the line and exit
-// non-zero. Nothing here aborts.
+// Every stage throws fvs::Error on bad input; the commands catch it, print the line and
+// exit non-zero. Nothing here aborts.
 #pragma once
 
 #include <stdexcept>
@@ -16,8 +16,7 @@ class Error : public std::runtime_error {
 };
 
 // Throws Error(subject, what) when the condition does not hold.
-inline void Require(bool condition, const std::string& subject,
-                    const std::string& what) {
+inline void Require(bool condition, const std::string& subject, const std::string& what) {
   if (!condition) throw Error(subject, what);
 }
 

@@ -17,8 +17,7 @@ struct ImageT {
 
   ImageT() = default;
   ImageT(int w, int h, int c, T fill = T(0))
-      : width(w), height(h), channels(c),
-        data(static_cast<size_t>(w) * h * c, fill) {}
+      : width(w), height(h), channels(c), data(static_cast<size_t>(w) * h * c, fill) {}
 
   bool empty() const { return data.empty(); }
   size_t Index(int x, int y, int c = 0) const {

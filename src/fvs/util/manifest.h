@@ -1,8 +1,8 @@
-// The record that lets a stage be skipped: for each stage, a fingerprint of its inputs (file
-// sizes and modification times, recursively for folders, plus its options) and the outputs
-// it produced. A stage is up to date when its fingerprint is unchanged and all its outputs
-// exist. Saved atomically after every stage, so a run killed at any point resumes with no
-// finished stage redone.
+// The record that lets a stage be skipped: for each stage, a fingerprint of its inputs
+// (file sizes and modification times, recursively for folders, plus its options) and the
+// outputs it produced. A stage is up to date when its fingerprint is unchanged and all
+// its outputs exist. Saved atomically after every stage, so a run killed at any point
+// resumes with no finished stage redone.
 #pragma once
 
 #include <map>
@@ -18,8 +18,8 @@ std::string StampPaths(const std::vector<std::string>& paths);
 
 class Manifest {
  public:
-  // A missing file gives an empty manifest; an unreadable or corrupt one too (with a warning
-  // on stderr): the worst that follows is that stages run again.
+  // A missing file gives an empty manifest; an unreadable or corrupt one too (with a
+  // warning on stderr): the worst that follows is that stages run again.
   static Manifest Load(const std::string& path);
   void Save() const;  // atomic
 

@@ -18,8 +18,7 @@ Progress::Progress(std::string label, int64_t total)
 Progress::~Progress() { Finish(); }
 
 double Progress::ElapsedSeconds() const {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_)
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
 void Progress::Advance(int64_t n) {
@@ -46,8 +45,7 @@ void Progress::Print(bool final_line) {
   const auto now = std::chrono::steady_clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
   if (total_ <= 0) {
-    if (!final_line &&
-        std::chrono::duration<double>(now - last_print_).count() < 1.0) {
+    if (!final_line && std::chrono::duration<double>(now - last_print_).count() < 1.0) {
       return;
     }
     last_print_ = now;
@@ -69,8 +67,7 @@ void Progress::Print(bool final_line) {
           percent == last_percent_printed_) {
         return;
       }
-    } else if (percent / 10 == last_percent_printed_ / 10 &&
-               last_percent_printed_ >= 0) {
+    } else if (percent / 10 == last_percent_printed_ / 10 && last_percent_printed_ >= 0) {
       return;  // Logs get a line per 10%.
     }
   }
@@ -80,10 +77,10 @@ void Progress::Print(bool final_line) {
   constexpr int kWidth = 30;
   std::string bar(kWidth, ' ');
   for (int i = 0; i < static_cast<int>(fraction * kWidth); ++i) bar[i] = '#';
-  std::fprintf(stderr, "%s%s [%s] %3d%% %lld/%lld %.1f s, ETA %.1f s%s",
-               tty_ ? "\r" : "", label_.c_str(), bar.c_str(), percent,
-               static_cast<long long>(done_), static_cast<long long>(total_), elapsed,
-               eta, (final_line || !tty_) ? "\n" : "");
+  std::fprintf(stderr, "%s%s [%s] %3d%% %lld/%lld %.1f s, ETA %.1f s%s", tty_ ? "\r" : "",
+               label_.c_str(), bar.c_str(), percent, static_cast<long long>(done_),
+               static_cast<long long>(total_), elapsed, eta,
+               (final_line || !tty_) ? "\n" : "");
   std::fflush(stderr);
 }
 

@@ -1,5 +1,5 @@
-// Progress for long stages on stderr: a redrawn bar on a terminal, a line every few percent
-// otherwise (logs, CI), so a user always sees what runs and how far it is.
+// Progress for long stages on stderr: a redrawn bar on a terminal, a line every few
+// percent otherwise (logs, CI), so a user always sees what runs and how far it is.
 #pragma once
 
 #include <chrono>
