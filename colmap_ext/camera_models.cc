@@ -294,15 +294,29 @@ bool CameraModelIsPinhole(int model_id) {
   return model_id == kSimplePinhole || model_id == kPinhole;
 }
 
-Eigen::Vector2d CameraWorldToImage(int model_id, const std::vector<double>& params,
-                                   const Eigen::Vector2d& normalized) {
+namespace {
+
+// Focal lengths, principal point and the distortion parameters after them: models with
+// one focal length store (f, cx, cy, ...), the others (fx, fy, cx, cy, ...).
+struct Intrinsics {
+  double f1, f2, c1, c2;
+  const double* extra;
+};
+
+Intrinsics SplitParams(int model_id, const std::vector<double>& params) {
   CheckParams(model_id, params);
   const bool single = HasSingleFocal(model_id);
-  const double f1 = params[0];
-  const double f2 = single ? params[0] : params[1];
-  const double c1 = single ? params[1] : params[2];
-  const double c2 = single ? params[2] : params[3];
-  const double* extra = params.data() + (single ? 3 : 4);
+  return {params[0], single ? params[0] : params[1], single ? params[1] : params[2],
+          single ? params[2] : params[3], params.data() + (single ? 3 : 4)};
+}
+
+}  // namespace
+
+Eigen::Vector2d CameraWorldToImage(int model_id, const std::vector<double>& params,
+                                   const Eigen::Vector2d& normalized) {
+  const Intrinsics in = SplitParams(model_id, params);
+  const double f1 = in.f1, f2 = in.f2, c1 = in.c1, c2 = in.c2;
+  const double* extra = in.extra;
   double u = normalized.x();
   double v = normalized.y();
   double x, y;
@@ -332,13 +346,9 @@ Eigen::Vector2d CameraWorldToImage(int model_id, const std::vector<double>& para
 
 Eigen::Vector2d CameraImageToWorld(int model_id, const std::vector<double>& params,
                                    const Eigen::Vector2d& pixel) {
-  CheckParams(model_id, params);
-  const bool single = HasSingleFocal(model_id);
-  const double f1 = params[0];
-  const double f2 = single ? params[0] : params[1];
-  const double c1 = single ? params[1] : params[2];
-  const double c2 = single ? params[2] : params[3];
-  const double* extra = params.data() + (single ? 3 : 4);
+  const Intrinsics in = SplitParams(model_id, params);
+  const double f1 = in.f1, f2 = in.f2, c1 = in.c1, c2 = in.c2;
+  const double* extra = in.extra;
   const Eigen::Vector2d uv((pixel.x() - c1) / f1, (pixel.y() - c2) / f2);
   if (CameraModelIsPinhole(model_id)) return uv;
   if (model_id == kFOV) {
