@@ -155,7 +155,7 @@ TEST(FvsNetTest, EveryVariantGivesFiniteImagesOfTheTargetSize) {
     torch::NoGradGuard no_grad;
     const torch::Tensor features = net->Encode(in.images);
     EXPECT_EQ(features.sizes().vec(),
-              std::vector<int64_t>({3, net->config().feature_channels, 37, 53}));
+              std::vector<int64_t>({3, net->config().EncodedChannels(), 37, 53}));
     for (const Inputs* x : {&in, &odd}) {
       const int64_t k = x->images.size(0), h = x->grid.size(1), w = x->grid.size(2);
       const BlendOutput out =
@@ -181,10 +181,40 @@ TEST(FvsNetTest, BadShapesThrow) {
   EXPECT_THROW(net->Blend(torch::zeros({2, 31, 8, 8}), torch::ones({1, 1, 8, 8}),
                           torch::ones({2, 1, 8, 8})),
                Error);
-  EXPECT_THROW(net->Blend(torch::zeros({2, 32, 8, 8}), torch::ones({1, 1, 8, 8}),
+  EXPECT_THROW(net->Blend(torch::zeros({2, 35, 8, 8}), torch::ones({1, 1, 8, 8}),
                           torch::ones({3, 1, 8, 8})),
                Error);
   EXPECT_THROW(WarpFeatures(torch::zeros({2, 4, 8, 8}), torch::zeros({1, 8, 8, 2})),
+               Error);
+}
+
+TEST(FvsNetTest, RgbSkipStartsAsTheMeanOfTheSourcesThatSeeAPixel) {
+  // fvs_fast untrained: zero heads, so each source contributes its own warped colour with
+  // confidence mask_prior * (valid_warp - 1).
+  torch::manual_seed(3);
+  FvsNet net(ModelConfig::ForVariant("fvs_fast"));
+  ASSERT_TRUE(net->config().rgb_skip);
+  const double prior = net->config().mask_prior;
+  ASSERT_GT(prior, 0);
+  net->eval();
+  torch::NoGradGuard no_grad;
+  const Inputs in = MakeInputs(3, 16, 24);
+  const torch::Tensor encoded = net->Encode(in.images);
+  EXPECT_TRUE(torch::equal(encoded.narrow(1, net->config().feature_channels, 3),
+                           in.images));
+  const torch::Tensor warped_rgb = WarpFeatures(in.images, in.grid);
+  const torch::Tensor w = torch::exp(prior * (in.valid_warp - 1));
+  const torch::Tensor expected =
+      ((w * warped_rgb).sum(0, true) / w.sum(0, true)).clamp(-1, 1);
+  const BlendOutput out = net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp);
+  EXPECT_LT((out.rgb - expected).abs().max().item<float>(), 1e-5f);
+  EXPECT_LT((out.per_source_rgb - warped_rgb).abs().max().item<float>(), 1e-6f);
+  // The option is refused where it has no per-source colours to correct.
+  EXPECT_THROW(
+      ModelConfig::FromJson(R"({"variant":"fvs_single","rgb_skip":true})"), Error);
+  EXPECT_THROW(
+      ModelConfig::FromJson(R"({"variant":"fvs_nomasks","mask_prior":2})"), Error);
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_fast","mask_prior":-1})"),
                Error);
 }
 

@@ -8,10 +8,12 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <set>
 
 #include "fvs/scene/source_selection.h"
+#include "fvs/net/net.h"
 #include "fvs/scene/warp.h"
 #include "fvs/train/data.h"
 #include "fvs/train/train_options.h"
@@ -187,6 +189,39 @@ TEST_F(PackTest, SamplerIsLeaveOneOutAndReproducible) {
   EXPECT_EQ(again.y0, next.y0);
   EXPECT_TRUE(torch::equal(again.source_rgb, next.source_rgb));
   EXPECT_THROW(c.SetState("not a state"), Error);
+}
+
+TEST_F(PackTest, CroppedSourcesSampleExactlyWhatTheFullSourcesDo) {
+  std::vector<PackedScene> scenes = {LoadPackedScene(dir_->path() + "/packed")};
+  SamplerOptions full_options;
+  full_options.num_sources = 3;
+  full_options.crop = 16;
+  full_options.augment = false;
+  SamplerOptions crop_options = full_options;
+  crop_options.source_margin = 2;
+  TrainingSampler full(&scenes, full_options, 5), cropped(&scenes, crop_options, 5);
+  int smaller = 0;
+  for (int i = 0; i < 30; ++i) {
+    const TrainingSample a = full.Next(), b = cropped.Next();
+    ASSERT_EQ(a.target, b.target);
+    ASSERT_EQ(a.x0, b.x0);
+    EXPECT_EQ(b.source_rgb.size(2) % 4 == 0 || b.source_rgb.size(2) == 36, true);
+    EXPECT_LE(b.source_rgb.size(2) * b.source_rgb.size(3),
+              a.source_rgb.size(2) * a.source_rgb.size(3));
+    smaller += b.source_rgb.size(2) * b.source_rgb.size(3) <
+               a.source_rgb.size(2) * a.source_rgb.size(3);
+    EXPECT_TRUE(torch::equal(a.warp.valid_warp, b.warp.valid_warp));
+    const torch::Tensor sa = WarpFeatures(a.source_rgb, a.warp.grid);
+    const torch::Tensor sb = WarpFeatures(b.source_rgb, b.warp.grid);
+    EXPECT_LT((sa - sb).abs().max().item<float>(), 1e-5f) << "sample " << i;
+  }
+  EXPECT_GT(smaller, 0);
+  // Nothing near any source: left as it is.
+  TrainingSample nothing = full.Next();
+  nothing.warp.grid.fill_(std::numeric_limits<float>::quiet_NaN());
+  const auto size = nothing.source_rgb.sizes().vec();
+  CropSourcesToFootprint(&nothing, 2, 4);
+  EXPECT_EQ(nothing.source_rgb.sizes().vec(), size);
 }
 
 TEST_F(PackTest, ColourJitterIsTheSameForTargetAndSources) {

@@ -27,6 +27,11 @@ using testing::TempDir;
 const char kTinyNet[] =
     R"({"variant": "fvs_fast", "feature_channels": 8, "encoder_channels": [8, 16, 16],
         "encoder_convs": [1, 1, 1], "blend_channels": [8, 16, 16], "blend_convs_per_stage": 2})";
+// The same without the colour skip: it starts from noise, so its loss must fall a lot.
+const char kTinyNetNoSkip[] =
+    R"({"variant": "fvs_fast", "feature_channels": 8, "encoder_channels": [8, 16, 16],
+        "encoder_convs": [1, 1, 1], "blend_channels": [8, 16, 16], "blend_convs_per_stage": 2,
+        "rgb_skip": false, "mask_prior": 0})";
 
 class TrainerTest : public ::testing::Test {
  protected:
@@ -69,21 +74,30 @@ TEST_F(TrainerTest, LossDecreasesOnAFixedSample) {
   const PackedScene scene = LoadPackedScene(dir_->path() + "/scene_a");
   const TrainingSample s = MakeSample(scene, 2, SelectTrainingSources(scene, 2, 2), 16, 8,
                                       32, 32, WarpSettings());
-  FvsNet net(ModelConfig::FromJson(kTinyNet));
-  torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(3e-3));
   TrainingLoss loss("", torch::kCPU);
+  auto train = [&](const char* config, double* first, double* last) {
+    FvsNet net(ModelConfig::FromJson(config));
+    torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(3e-3));
+    for (int i = 0; i < 30; ++i) {
+      adam.zero_grad();
+      const BlendOutput out =
+          net->Forward(s.source_rgb, s.warp.grid, s.warp.valid_depth, s.warp.valid_warp);
+      LossValue l = loss((out.rgb + 1) * 0.5, s.target_rgb);
+      l.total.backward();
+      adam.step();
+      (i == 0 ? *first : *last) = l.l1 + l.second;
+    }
+  };
   double first = 0, last = 0;
-  for (int i = 0; i < 30; ++i) {
-    adam.zero_grad();
-    const BlendOutput out =
-        net->Forward(s.source_rgb, s.warp.grid, s.warp.valid_depth, s.warp.valid_warp);
-    LossValue l = loss((out.rgb + 1) * 0.5, s.target_rgb);
-    l.total.backward();
-    adam.step();
-    (i == 0 ? first : last) = l.l1 + l.second;
-  }
+  train(kTinyNetNoSkip, &first, &last);
   EXPECT_TRUE(std::isfinite(last));
   EXPECT_LT(last, 0.7 * first) << "first " << first << " last " << last;
+  // With the colour skip the untrained net already blends the sources: it starts far
+  // lower and does not get worse.
+  double skip_first = 0, skip_last = 0;
+  train(kTinyNet, &skip_first, &skip_last);
+  EXPECT_LT(skip_first, 0.5 * first) << skip_first << " vs " << first;
+  EXPECT_LE(skip_last, skip_first * 1.05) << skip_first << " -> " << skip_last;
 }
 
 TEST_F(TrainerTest, SsimIsOneForEqualImagesAndLowerOtherwise) {

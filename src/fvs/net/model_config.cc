@@ -1,5 +1,6 @@
 #include "fvs/net/model_config.h"
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "fvs/util/error.h"
@@ -58,6 +59,10 @@ ModelConfig ModelConfig::ForVariant(const std::string& name) {
     c.blend_channels = {16, 32, 64, 128};
     c.blend_convs_per_stage = 2;
     c.depthwise_separable = false;
+    // Trains on a CPU in hours rather than weeks: it starts as the mean of the sources
+    // that see a pixel and learns confidences and corrections from there.
+    c.rgb_skip = true;
+    c.mask_prior = 4.0;
   } else {
     throw Error(kSubject, "unknown network variant '" + name +
                               "' (known: " + JoinNames(KnownVariants()) + ")");
@@ -78,6 +83,8 @@ std::string ModelConfig::ToJson() const {
   j["blend_channels"] = blend_channels;
   j["blend_convs_per_stage"] = blend_convs_per_stage;
   j["depthwise_separable"] = depthwise_separable;
+  j["rgb_skip"] = rgb_skip;
+  j["mask_prior"] = mask_prior;
   return j.dump();
 }
 
@@ -103,7 +110,9 @@ ModelConfig ModelConfig::FromJson(const std::string& text) {
                                         "encoder_convs",
                                         "blend_channels",
                                         "blend_convs_per_stage",
-                                        "depthwise_separable"};
+                                        "depthwise_separable",
+                                        "rgb_skip",
+                                        "mask_prior"};
   for (auto it = j.begin(); it != j.end(); ++it) {
     bool known = false;
     for (const char* field : kFields) known = known || it.key() == field;
@@ -120,6 +129,8 @@ ModelConfig ModelConfig::FromJson(const std::string& text) {
   Read(j, "blend_channels", &c.blend_channels);
   Read(j, "blend_convs_per_stage", &c.blend_convs_per_stage);
   Read(j, "depthwise_separable", &c.depthwise_separable);
+  Read(j, "rgb_skip", &c.rgb_skip);
+  Read(j, "mask_prior", &c.mask_prior);
   c.Check();
   return c;
 }
@@ -148,6 +159,11 @@ void ModelConfig::Check() const {
   }
   require(blend_convs_per_stage >= 1 && blend_convs_per_stage <= 8,
           "blend_convs_per_stage must be in [1, 8]");
+  require(!rgb_skip || soft_argmax, "rgb_skip needs soft_argmax (per-source colours)");
+  require(std::isfinite(mask_prior) && mask_prior >= 0 && mask_prior <= 30,
+          "mask_prior must be in [0, 30]");
+  require(mask_prior == 0 || (use_masks && soft_argmax),
+          "mask_prior needs use_masks and soft_argmax");
 }
 
 }  // namespace fvs

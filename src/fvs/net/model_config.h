@@ -34,6 +34,15 @@ struct ModelConfig {
   int blend_convs_per_stage = 3;
   // Depthwise 3x3 + pointwise 1x1 instead of dense 3x3 convs (the CPU variant).
   bool depthwise_separable = false;
+  // The encoder's output also carries the source's own RGB (3 more channels, warped with
+  // the features), and each source's RGB head predicts a correction to its warped
+  // colour (head initialised to zero). Not in the paper: a network that starts as an
+  // average of the warped sources trains in far fewer steps (the CPU variant).
+  bool rgb_skip = false;
+  // > 0: mask_prior * (valid_warp - 1) is added to each source's confidence, so a source
+  // that does not see a pixel starts with e^-mask_prior of the weight (needs use_masks
+  // and soft_argmax). 0 = the paper's purely learnt confidences.
+  double mask_prior = 0;
 
   // Throws fvs::Error for an unknown name, listing the known ones.
   static ModelConfig ForVariant(const std::string& name);
@@ -47,8 +56,10 @@ struct ModelConfig {
   // Throws fvs::Error("model config", ...) when the numbers cannot make a network.
   void Check() const;
 
+  // Channels of Encode's output (and of the warped features) per source.
+  int EncodedChannels() const { return feature_channels + (rgb_skip ? 3 : 0); }
   // Input channels of the blending net per source.
-  int BlendInputChannels() const { return feature_channels + (use_masks ? 2 : 0); }
+  int BlendInputChannels() const { return EncodedChannels() + (use_masks ? 2 : 0); }
   // Input sizes are padded to a multiple of these (total down-sampling of the U-Nets).
   int EncoderStride() const { return 1 << (encoder_channels.size() - 1); }
   int BlendStride() const { return 1 << (blend_channels.size() - 1); }

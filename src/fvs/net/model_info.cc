@@ -48,10 +48,11 @@ std::string FormatModelInfo(const ModelInfo& info) {
   const ModelConfig& c = info.config;
   std::snprintf(line, sizeof(line),
                 "%s: features %d, masks %s, gru %s, soft-argmax %s, inf-depth %s, "
-                "separable %s\n",
+                "separable %s, rgb skip %s, mask prior %g\n",
                 c.variant.c_str(), c.feature_channels, c.use_masks ? "yes" : "no",
                 c.use_gru ? "yes" : "no", c.soft_argmax ? "yes" : "no",
-                c.inf_depth ? "yes" : "no", c.depthwise_separable ? "yes" : "no");
+                c.inf_depth ? "yes" : "no", c.depthwise_separable ? "yes" : "no",
+                c.rgb_skip ? "yes" : "no", c.mask_prior);
   s += line;
   std::snprintf(
       line, sizeof(line), "  parameters: encoder %lld, blender %lld, total %lld\n",

@@ -193,6 +193,14 @@ FvsNetImpl::FvsNetImpl(const ModelConfig& config) : config_(config) {
     confidence_head_ = register_module(
         "confidence_head", torch::nn::Conv2d(torch::nn::Conv2dOptions(bc[0], 1, 1)));
   }
+  if (config_.rgb_skip) {
+    // Zero heads: every source first contributes its warped colour with equal confidence.
+    torch::NoGradGuard no_grad;
+    rgb_head_->weight.zero_();
+    rgb_head_->bias.zero_();
+    confidence_head_->weight.zero_();
+    confidence_head_->bias.zero_();
+  }
 }
 
 torch::Tensor FvsNetImpl::Encode(const torch::Tensor& images) {
@@ -212,6 +220,7 @@ torch::Tensor FvsNetImpl::Encode(const torch::Tensor& images) {
     x = torch::cat({UpsampleTo(x, skip), skip}, 1);
     for (ConvUnit& unit : encoder_up_[i]) x = torch::relu(unit(x));
   }
+  if (config_.rgb_skip) return torch::cat({Crop(x, height, width), images}, 1);
   return Crop(x, height, width);
 }
 
@@ -242,9 +251,9 @@ BlendOutput FvsNetImpl::Blend(const torch::Tensor& warped,
                               const torch::Tensor& valid_depth,
                               const torch::Tensor& valid_warp) {
   Require(warped.dim() == 4 && warped.size(0) > 0 &&
-              warped.size(1) == config_.feature_channels,
+              warped.size(1) == config_.EncodedChannels(),
           kSubject,
-          "Blend expects warped features [K," + std::to_string(config_.feature_channels) +
+          "Blend expects warped features [K," + std::to_string(config_.EncodedChannels()) +
               ",H,W], got " + Shape(warped));
   const int64_t k = warped.size(0), height = warped.size(2), width = warped.size(3);
   if (config_.use_masks) {
@@ -282,11 +291,21 @@ BlendOutput FvsNetImpl::Blend(const torch::Tensor& warped,
   // otherwise hold 3.7 GB of top states).
   std::vector<torch::Tensor> rgbs, confidences;
   torch::Tensor last;  // the top state that has seen every source (fvs_single)
-  auto heads = [&](const torch::Tensor& padded_top) {
+  auto heads = [&](const torch::Tensor& padded_top, int64_t first, int64_t count) {
     const torch::Tensor top = Crop(padded_top, height, width);
     if (config_.soft_argmax) {
-      rgbs.push_back(rgb_head_(top));
-      confidences.push_back(confidence_head_(top));
+      torch::Tensor rgb = rgb_head_(top);
+      if (config_.rgb_skip) {
+        rgb = rgb + warped.narrow(0, first, count).narrow(1, config_.feature_channels, 3);
+      }
+      torch::Tensor confidence = confidence_head_(top);
+      if (config_.mask_prior > 0) {
+        confidence = confidence +
+                     config_.mask_prior *
+                         (valid_warp.narrow(0, first, count).to(confidence.options()) - 1);
+      }
+      rgbs.push_back(rgb);
+      confidences.push_back(confidence);
     } else {
       // Without recurrence no state has seen every source: average the sources' states.
       last = config_.use_gru ? top : top.mean(0, /*keepdim=*/true);
@@ -294,9 +313,9 @@ BlendOutput FvsNetImpl::Blend(const torch::Tensor& warped,
   };
   std::vector<torch::Tensor> state(blend_stages_.size());
   if (config_.use_gru) {
-    for (int64_t i = 0; i < k; ++i) heads(BlendPass(input(i, 1), &state));
+    for (int64_t i = 0; i < k; ++i) heads(BlendPass(input(i, 1), &state), i, 1);
   } else {
-    heads(BlendPass(input(0, k), &state));
+    heads(BlendPass(input(0, k), &state), 0, k);
   }
 
   BlendOutput out;

@@ -67,7 +67,8 @@ class FvsNetImpl : public torch::nn::Module {
   explicit FvsNetImpl(const ModelConfig& config);
   const ModelConfig& config() const { return config_; }
 
-  // [K,3,H,W] in [-1,1], any H, W -> [K,feature_channels,H,W].
+  // [K,3,H,W] in [-1,1], any H, W -> [K,config.EncodedChannels(),H,W] (the features,
+  // then the image itself with rgb_skip).
   torch::Tensor Encode(const torch::Tensor& images);
   // warped [K,C,Ht,Wt], valid_depth [1,1,Ht,Wt], valid_warp [K,1,Ht,Wt] (float 0/1).
   BlendOutput Blend(const torch::Tensor& warped, const torch::Tensor& valid_depth,

@@ -1,6 +1,7 @@
 #include "fvs/train/data.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -232,6 +233,53 @@ TrainingSample MakeSample(const PackedScene& scene, int target,
   return s;
 }
 
+void CropSourcesToFootprint(TrainingSample* sample, int margin, int multiple) {
+  using torch::indexing::Slice;
+  Require(margin >= 1 && multiple >= 1, "CropSourcesToFootprint",
+          "margin and multiple must be positive");
+  const int64_t k = sample->source_rgb.size(0);
+  const int64_t height = sample->source_rgb.size(2), width = sample->source_rgb.size(3);
+  // Source pixel positions (pixel i spans [i, i+1]) of every target pixel; only positions
+  // within a pixel of the image can pick up a non-zero bilinear weight.
+  const torch::Tensor grid = sample->warp.grid.to(torch::kDouble);
+  const torch::Tensor u = (grid.select(3, 0) + 1) * (0.5 * width);
+  const torch::Tensor v = (grid.select(3, 1) + 1) * (0.5 * height);
+  const torch::Tensor near = torch::isfinite(u) & torch::isfinite(v) & (u >= -1) &
+                             (u <= width + 1) & (v >= -1) & (v <= height + 1);
+  std::vector<int64_t> x0(k), y0(k), x1(k), y1(k);
+  int64_t box_w = 0, box_h = 0;
+  for (int64_t i = 0; i < k; ++i) {
+    const torch::Tensor m = near[i];
+    if (!m.any().item<bool>()) {
+      x0[i] = y0[i] = 0, x1[i] = y1[i] = 1;
+      continue;
+    }
+    const torch::Tensor us = u[i].masked_select(m), vs = v[i].masked_select(m);
+    x0[i] = std::max<int64_t>(0, static_cast<int64_t>(std::floor(us.min().item<double>())) - margin);
+    y0[i] = std::max<int64_t>(0, static_cast<int64_t>(std::floor(vs.min().item<double>())) - margin);
+    x1[i] = std::min<int64_t>(width, static_cast<int64_t>(std::ceil(us.max().item<double>())) + margin);
+    y1[i] = std::min<int64_t>(height, static_cast<int64_t>(std::ceil(vs.max().item<double>())) + margin);
+    box_w = std::max(box_w, x1[i] - x0[i]);
+    box_h = std::max(box_h, y1[i] - y0[i]);
+  }
+  if (box_w == 0) return;
+  box_w = std::min<int64_t>(width, (box_w + multiple - 1) / multiple * multiple);
+  box_h = std::min<int64_t>(height, (box_h + multiple - 1) / multiple * multiple);
+  if (box_w == width && box_h == height) return;
+  std::vector<torch::Tensor> crops, grids;
+  for (int64_t i = 0; i < k; ++i) {
+    const int64_t ox = std::clamp<int64_t>(x0[i], 0, width - box_w);
+    const int64_t oy = std::clamp<int64_t>(y0[i], 0, height - box_h);
+    crops.push_back(sample->source_rgb[i].index(
+        {Slice(), Slice(oy, oy + box_h), Slice(ox, ox + box_w)}));
+    grids.push_back(torch::stack({(u[i] - ox) * (2.0 / box_w) - 1,
+                                  (v[i] - oy) * (2.0 / box_h) - 1},
+                                 2));
+  }
+  sample->source_rgb = torch::stack(crops).contiguous();
+  sample->warp.grid = torch::stack(grids).to(sample->warp.grid.scalar_type()).contiguous();
+}
+
 void ApplyColorJitter(const ColorJitter& j, TrainingSample* sample) {
   const auto gain = torch::tensor({j.gain[0], j.gain[1], j.gain[2]}, torch::kFloat)
                         .reshape({1, 3, 1, 1});
@@ -278,6 +326,10 @@ TrainingSample TrainingSampler::Next() {
       scene, target, SelectTrainingSources(scene, target, options_.num_sources), x0, y0,
       cw, ch, options_.warp);
   sample.scene = scene_index;
+  if (options_.source_margin >= 0) {
+    // Multiple of 4: the encoder's stride, so no padding is added to the crop.
+    CropSourcesToFootprint(&sample, std::max(1, options_.source_margin), 4);
+  }
   if (options_.augment) {
     ColorJitter j;
     j.brightness = Uniform(-0.08, 0.08);

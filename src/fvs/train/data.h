@@ -85,10 +85,21 @@ struct ColorJitter {
 };
 void ApplyColorJitter(const ColorJitter& jitter, TrainingSample* sample);
 
+// Crops every source of a sample to the part its target crop samples (plus `margin`
+// pixels; one common size, a multiple of `multiple`, per-source offsets) and rewrites the
+// grid to match, so the encoder runs on that part only. Bilinear samples of the cropped
+// sources equal those of the full ones exactly; the encoded features differ only within
+// the encoder's receptive field of a crop border that is not an image border. A sample
+// whose grid has no finite position near any source is left as it is.
+void CropSourcesToFootprint(TrainingSample* sample, int margin, int multiple);
+
 struct SamplerOptions {
   int num_sources = 5;
   int crop = 192;
   bool augment = true;
+  // >= 0: CropSourcesToFootprint with this margin (the trainer's default, 16); < 0: full
+  // sources.
+  int source_margin = -1;
   WarpSettings warp;
 };
 

@@ -40,6 +40,9 @@ std::vector<OptionSpec> Specs(TrainOptions* o) {
       {"Train.num_sources", Kind::kInt, &o->num_sources, false,
        "K: sources per target (top-K by overlap)"},
       {"Train.crop", Kind::kInt, &o->crop, false, "square target crop in pixels"},
+      {"Train.source_margin", Kind::kInt, &o->source_margin, false,
+       "encode only the part of each source the crop samples, plus this margin in "
+       "pixels (-1: whole sources)"},
       {"Train.batch_size", Kind::kInt, &o->batch_size, false,
        "targets per optimiser step (gradients accumulated)"},
       {"Train.learning_rate", Kind::kDouble, &o->learning_rate, false, "Adam step size"},
@@ -110,6 +113,7 @@ void TrainOptions::Check() const {
   Require(num_sources >= 1, kSubject, "--Train.num_sources must be at least 1");
   Require(crop >= 16, kSubject, "--Train.crop must be at least 16 (SSIM window)");
   Require(batch_size >= 1, kSubject, "--Train.batch_size must be at least 1");
+  Require(source_margin >= -1, kSubject, "--Train.source_margin must be >= -1");
   Require(learning_rate > 0, kSubject, "--Train.learning_rate must be positive");
   Require(checkpoint_minutes > 0, kSubject,
           "--Train.checkpoint_minutes must be positive");

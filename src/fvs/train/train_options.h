@@ -20,6 +20,9 @@ struct TrainOptions {
   int max_steps = 100000;
   int num_sources = 5;
   int crop = 192;
+  // Pixels kept around the part of each source a target crop samples: the encoder runs
+  // on that part only (CropSourcesToFootprint). -1: whole sources, as the paper.
+  int source_margin = 16;
   int batch_size = 1;  // targets per optimiser step (gradients accumulated)
   double learning_rate = 1e-4;
   double checkpoint_minutes = 10;

@@ -119,6 +119,7 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
   sampler.num_sources = k;
   sampler.crop = options_.crop;
   sampler.augment = options_.augment;
+  sampler.source_margin = options_.source_margin;
   sampler.warp.occlusion_tolerance = options_.occlusion_tolerance;
   sampler.warp.inf_depth = config_.inf_depth;
   // A seed of its own stream: the sampler must not share draws with LibTorch.
@@ -252,6 +253,7 @@ std::string Trainer::SaveModel() {
   card["steps"] = step_;
   card["batch_size"] = options_.batch_size;
   card["crop"] = options_.crop;
+  card["source_margin"] = options_.source_margin;
   card["num_sources"] = options_.num_sources;
   card["learning_rate"] = options_.learning_rate;
   card["seed"] = options_.seed;
