@@ -17,6 +17,7 @@
 #include "colmap_ext/sparse_io.h"
 #include "fvs/geometry/ply.h"
 #include "fvs/mvs/delaunay_scene.h"
+#include "fvs/mvs/isolated_points.h"
 #include "fvs/util/error.h"
 #include "support/test_support.h"
 
@@ -110,6 +111,77 @@ TEST(DelaunayMesher, ToleratesManyOutliers) {
       "outliers: vertex mean %.4f p90 %.4f, face mean %.4f p90 %.4f, coverage %.3f\n",
       acc.vertex_mean, acc.vertex_p90, acc.face_mean, acc.face_p90, acc.coverage);
   ExpectAccurate(acc, "25% outliers");
+}
+
+TEST(IsolatedPoints, FlagsOnlyPointsFarFromTheRest) {
+  // A 30 x 30 grid of 1 cm spacing, and three points 1 m away from it and each other.
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 30; ++i) {
+    for (int j = 0; j < 30; ++j) points.emplace_back(0.01 * i, 0.01 * j, 0.0);
+  }
+  const size_t first_stray = points.size();
+  points.emplace_back(1.5, 0.1, 0.3);
+  points.emplace_back(0.1, 1.4, -0.6);
+  points.emplace_back(-1.0, -1.0, 1.0);
+  const std::vector<double> spacing = MeanNeighborDistances(points, 4, 2);
+  EXPECT_NEAR(spacing[31], (0.01 * 4 + 0.0) / 4, 1e-12);  // 4 neighbours at 1 cm
+  IsolatedPointOptions options;
+  const std::vector<bool> isolated = FindIsolatedPoints(points, options);
+  for (size_t i = 0; i < points.size(); ++i) EXPECT_EQ(isolated[i], i >= first_stray) << i;
+  // Far from the origin: the same answer.
+  for (auto& p : points) p += Eigen::Vector3d(3e4, -1e4, 2e3);
+  EXPECT_EQ(FindIsolatedPoints(points, options), isolated);
+  options.num_neighbors = 0;
+  const std::vector<bool> none = FindIsolatedPoints(points, options);
+  EXPECT_EQ(std::count(none.begin(), none.end(), true), 0);
+  options.num_neighbors = 8;
+  options.factor = 0.5;
+  EXPECT_THROW(options.Check(), Error);
+}
+
+TEST(DelaunayMesher, StrayPointsAnchorNoFaces) {
+  // Clusters of 3 points in the empty space around the objects, each seen by 5 cameras
+  // (as fused background noise is): with the default filters no face reaches them and the
+  // accuracy of the rest is unchanged; without them (COLMAP's behaviour) faces do.
+  const MeshingScene scene = MakeObjectScene(12);
+  SampledCloud cloud = SampleScene(scene, 20000, kNoise, 0.0, 6);
+  Eigen::Vector3d lo = cloud.input.points[0], hi = lo;
+  for (const auto& p : cloud.input.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const Eigen::Vector3d size = hi - lo;
+  std::vector<Eigen::Vector3d> strays;
+  for (int c = 0; c < 6; ++c) {
+    const Eigen::Vector3d centre =
+        lo + size.cwiseProduct(Eigen::Vector3d(c % 2 ? -0.25 : 1.25, 0.2 + 0.12 * c,
+                                               c % 3 ? 1.2 : -0.2));
+    for (int j = 0; j < 3; ++j) {
+      const Eigen::Vector3d p = centre + Eigen::Vector3d(0.004 * j, -0.003 * j, 0.002 * j);
+      strays.push_back(p);
+      cloud.input.points.push_back(p);
+      cloud.input.visibility.push_back({0, 2, 4, 6, 8});
+    }
+  }
+  auto touches_stray = [&](const TriangleMesh& mesh) {
+    size_t n = 0;
+    for (const auto& f : mesh.faces) {
+      for (int j = 0; j < 3; ++j) {
+        for (const auto& s : strays) n += (mesh.vertices[f[j]] - s).norm() < 1e-9;
+      }
+    }
+    return n;
+  };
+  DelaunayMeshingStats stats;
+  const TriangleMesh filtered = DelaunayMeshing(cloud.input, TestOptions(), &stats);
+  std::printf("strays: %s\n", stats.Summary().c_str());
+  EXPECT_GE(stats.num_isolated_points, strays.size());
+  EXPECT_EQ(touches_stray(filtered), 0u);
+  ExpectAccurate(EvaluateMesh(scene, filtered, cloud.true_points, 5 * kNoise), "strays");
+  DelaunayMeshingOptions colmap_like = TestOptions();
+  colmap_like.isolated_point_neighbors = 0;
+  colmap_like.max_side_spacing_factor = 0;
+  const TriangleMesh unfiltered = DelaunayMeshing(cloud.input, colmap_like);
+  const size_t unfiltered_touching = touches_stray(unfiltered);
+  std::printf("strays, unfiltered: %zu faces touch them\n", unfiltered_touching);
+  EXPECT_GT(unfiltered_touching, 0u);  // the case the filters are for
 }
 
 TEST(DelaunayMesher, FarFromOriginMeshesAsAtOrigin) {

@@ -47,6 +47,16 @@ int RunViewSynthesisMesher(int argc, char** argv) {
   options.AddDefault("DelaunayMeshing.max_side_length_percentile",
                      &o.max_side_length_percentile,
                      "... this percentile of the faces' longest sides");
+  options.AddDefault("DelaunayMeshing.isolated_point_neighbors",
+                     &o.isolated_point_neighbors,
+                     "not in COLMAP: drop points far from their k nearest points before "
+                     "meshing (0: keep all)");
+  options.AddDefault("DelaunayMeshing.isolated_point_factor", &o.isolated_point_factor,
+                     "... farther than this factor times the median neighbour distance");
+  options.AddDefault("DelaunayMeshing.max_side_spacing_factor",
+                     &o.max_side_spacing_factor,
+                     "not in COLMAP: drop faces longer than this factor times the local "
+                     "point spacing at their vertices (0: off)");
   options.AddDefault("DelaunayMeshing.num_threads", &o.num_threads,
                      "threads (-1: all cores)");
   if (!options.Parse(argc, argv)) return 0;

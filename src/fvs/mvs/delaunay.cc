@@ -1,6 +1,7 @@
 // The CGAL / Boost.Graph part of the Delaunay graph-cut mesher (see delaunay.h). This is
 // the only translation unit that includes CGAL: it compiles slowly and needs much memory.
 #include "fvs/mvs/delaunay.h"
+#include "fvs/mvs/isolated_points.h"
 
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
@@ -672,9 +673,21 @@ class Mesher {
         Percentile(std::move(longest), options_.max_side_length_percentile);
     stats->max_side_length = max_side;
 
+    std::vector<double> spacing;
+    if (options_.max_side_spacing_factor > 0) {
+      spacing = MeanNeighborDistances(vertex_points_, 8, num_threads_);
+    }
     std::vector<int> new_index(vertices_.size(), -1);
     for (const Face& face : faces) {
       if (face.longest > max_side) continue;
+      if (!spacing.empty()) {
+        const double local =
+            std::min({spacing[face.v[0]], spacing[face.v[1]], spacing[face.v[2]]});
+        if (face.longest > options_.max_side_spacing_factor * local) {
+          ++stats->num_spacing_filtered;
+          continue;
+        }
+      }
       Eigen::Vector3i out;
       for (int j = 0; j < 3; ++j) {
         int& index = new_index[face.v[j]];
@@ -726,8 +739,29 @@ TriangleMesh DelaunayMeshing(const DelaunayMeshingInput& input,
   options.Check();
   input.Check();
   DelaunayMeshingStats local_stats;
-  Mesher mesher(input, options);
-  TriangleMesh mesh = mesher.Run(stats ? stats : &local_stats);
+  if (!stats) stats = &local_stats;
+  IsolatedPointOptions isolated_options;
+  isolated_options.num_neighbors = options.isolated_point_neighbors;
+  isolated_options.factor = options.isolated_point_factor;
+  isolated_options.num_threads = options.num_threads;
+  const std::vector<bool> isolated = FindIsolatedPoints(input.points, isolated_options);
+  const size_t num_isolated = std::count(isolated.begin(), isolated.end(), true);
+  DelaunayMeshingInput kept;
+  if (num_isolated > 0) {
+    kept.cameras = input.cameras;
+    kept.points_subject = input.points_subject;
+    kept.visibility_subject = input.visibility_subject;
+    for (size_t i = 0; i < input.points.size(); ++i) {
+      if (isolated[i]) continue;
+      kept.points.push_back(input.points[i]);
+      kept.visibility.push_back(input.visibility[i]);
+    }
+    kept.Check();
+  }
+  Mesher mesher(num_isolated > 0 ? kept : input, options);
+  TriangleMesh mesh = mesher.Run(stats);
+  stats->num_input_points = input.points.size();
+  stats->num_isolated_points = num_isolated;
   for (const auto& v : mesh.vertices) {
     Require(v.allFinite(), input.points_subject,
             "non-finite mesh vertex (internal error)");

@@ -72,6 +72,17 @@ struct DelaunayMeshingOptions {
   // Long-edge filter: drop faces whose longest side exceeds factor x percentile.
   double max_side_length_factor = 25.0;
   double max_side_length_percentile = 95.0;
+  // Not in COLMAP: before triangulation, drop points whose mean distance to their
+  // isolated_point_neighbors nearest points exceeds isolated_point_factor x the median of
+  // that distance (isolated_points.h): stray background points otherwise anchor huge
+  // triangles. 0 neighbours = keep every point, as COLMAP.
+  int isolated_point_neighbors = 8;
+  double isolated_point_factor = 6.0;
+  // Not in COLMAP: also drop faces whose longest side exceeds this factor x the smallest
+  // local point spacing (mean distance to the 8 nearest points) at its vertices. Faces
+  // that bridge empty space between parts of the cloud fail it; faces in sparse regions
+  // do not, as their spacing is large too. 0 = off, as COLMAP.
+  double max_side_spacing_factor = 10.0;
   // <= 0: DefaultNumThreads() (COLMAP uses -1 for "all").
   int num_threads = -1;
 
@@ -97,11 +108,13 @@ struct DelaunayMeshingInput {
 
 struct DelaunayMeshingStats {
   size_t num_input_points = 0;
+  size_t num_isolated_points = 0;  // dropped before triangulation
   size_t num_vertices = 0;        // triangulation vertices (after merging)
   size_t num_cells = 0;           // including infinite cells
   size_t num_rays = 0;            // (vertex, image) rays cast
   size_t num_ray_steps = 0;       // facets crossed by all rays
   size_t num_surface_facets = 0;  // before the long-edge filter
+  size_t num_spacing_filtered = 0;  // faces dropped by max_side_spacing_factor
   size_t num_faces = 0;           // in the output mesh
   size_t num_mesh_vertices = 0;
   double distance_sigma = 0;

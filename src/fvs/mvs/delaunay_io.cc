@@ -10,6 +10,7 @@
 #include "colmap_ext/workspace.h"
 #include "fvs/geometry/ply.h"
 #include "fvs/mvs/delaunay.h"
+#include "fvs/mvs/isolated_points.h"
 #include "fvs/util/error.h"
 #include "fvs/util/progress.h"
 #include "fvs/util/string_util.h"
@@ -95,6 +96,12 @@ void DelaunayMeshingOptions::Check() const {
           "max_side_length_percentile must be in [0, 100], not " +
               Num(max_side_length_percentile));
   require(num_threads >= -1, "num_threads must be -1 (all), 0 (all) or positive");
+  require(std::isfinite(max_side_spacing_factor) && max_side_spacing_factor >= 0,
+          "max_side_spacing_factor must be >= 0, not " + Num(max_side_spacing_factor));
+  IsolatedPointOptions isolated;
+  isolated.num_neighbors = isolated_point_neighbors;
+  isolated.factor = isolated_point_factor;
+  isolated.Check();
 }
 
 void DelaunayMeshingInput::Check() const {
@@ -129,13 +136,13 @@ std::string DelaunayMeshingStats::Summary() const {
   char buffer[512];
   std::snprintf(
       buffer, sizeof(buffer),
-      "%zu points -> %zu vertices, %zu cells, %zu rays (%.0f steps each), %zu surface "
-      "facets -> %zu "
-      "faces, %zu vertices; time %.2f s (triangulation %.2f, visibility %.2f, "
+      "%zu points (%zu isolated dropped) -> %zu vertices, %zu cells, %zu rays (%.0f "
+      "steps each), %zu surface facets -> %zu "
+      "faces (%zu dropped by local spacing), %zu vertices; time %.2f s (triangulation %.2f, visibility %.2f, "
       "graph cut %.2f, extraction %.2f)",
-      num_input_points, num_vertices, num_cells, num_rays,
+      num_input_points, num_isolated_points, num_vertices, num_cells, num_rays,
       num_rays ? static_cast<double>(num_ray_steps) / num_rays : 0.0, num_surface_facets,
-      num_faces, num_mesh_vertices, seconds_total, seconds_triangulation,
+      num_faces, num_spacing_filtered, num_mesh_vertices, seconds_total, seconds_triangulation,
       seconds_visibility, seconds_graph, seconds_extraction);
   return buffer;
 }
