@@ -30,6 +30,20 @@ TEST(PrepareStages, RecognisesVideoFrames) {
   EXPECT_FALSE(LooksLikeVideoFrames(mixed));
 }
 
+TEST(PrepareStages, WarnsWhenUndistortionShrinksTheImages) {
+  colmap::Reconstruction sfm, undistorted;
+  sfm.cameras[1] = {1, 2, 800, 800, {562, 400, 400, -0.166}};  // ethiopian_head's estimate
+  sfm.cameras[2] = {2, 2, 1600, 1200, {1200, 800, 600, -0.01}};
+  undistorted.cameras[1] = {1, 1, 160, 160, {112, 112, 80, 80}};  // COLMAP's min_scale
+  undistorted.cameras[2] = {2, 1, 780, 590, {590, 590, 390, 295}};  // at max_image_size 800
+  const std::vector<std::string> warnings =
+      ShrunkenUndistortionWarnings(sfm, undistorted, 800);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("camera 1 from 800x800 to 160x160"), std::string::npos)
+      << warnings[0];
+  EXPECT_TRUE(ShrunkenUndistortionWarnings(sfm, sfm, 0).empty());
+}
+
 TEST(PrepareStages, HoldoutListFromCommasOrFile) {
   EXPECT_TRUE(ParseHoldoutList("").empty());
   EXPECT_EQ(ParseHoldoutList("a.jpg, b.jpg,,"),

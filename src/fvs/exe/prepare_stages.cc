@@ -25,6 +25,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
+
+
 const char* kWho = "colmap view_synthesis_prepare";
 
 // FNV-1a: a stable digest for chaining fingerprints (std::hash is not stable across
@@ -216,6 +218,30 @@ void WriteStereoConfigs(const std::string& workspace_path,
                   [&](std::ostream& out) { out << fusion.str(); });
 }
 
+std::vector<std::string> ShrunkenUndistortionWarnings(
+    const colmap::Reconstruction& sfm, const colmap::Reconstruction& undistorted,
+    int max_image_size) {
+  std::vector<std::string> warnings;
+  for (const auto& [id, camera] : undistorted.cameras) {
+    const auto it = sfm.cameras.find(id);
+    if (it == sfm.cameras.end()) continue;
+    const double before =
+        static_cast<double>(std::max(it->second.width, it->second.height));
+    const double expected =
+        max_image_size > 0 ? std::min<double>(before, max_image_size) : before;
+    const double after = static_cast<double>(std::max(camera.width, camera.height));
+    if (expected > 0 && after < 0.5 * expected) {
+      warnings.push_back(
+          "undistortion shrank camera " + std::to_string(id) + " from " +
+          std::to_string(it->second.width) + "x" + std::to_string(it->second.height) +
+          " to " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+          ": its distortion estimate cannot be undone at the image borders; try "
+          "--ImageReader.camera_model OPENCV (or PINHOLE for undistorted photos)");
+    }
+  }
+  return warnings;
+}
+
 void RunPrepareStages(const PrepareContext& c) {
   const std::vector<std::string> images = ListImageFiles(c.image_path);
   for (const std::string& name : c.holdout) {
@@ -331,6 +357,10 @@ void RunPrepareStages(const PrepareContext& c) {
                                   std::to_string(c.max_image_size)});
                const colmap::Reconstruction rec =
                    colmap::ReadSparseModel(out + "/sparse");
+               for (const std::string& w : ShrunkenUndistortionWarnings(
+                        colmap::ReadSparseModel(sfm_model), rec, c.max_image_size)) {
+                 std::cerr << "WARNING: " << w << "\n";
+               }
                for (const std::string& h : c.holdout) {
                  if (rec.FindImageByName(h) == nullptr) {
                    throw Error(c.image_path,

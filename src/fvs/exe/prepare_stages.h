@@ -1,6 +1,8 @@
 // The stages of view_synthesis_prepare (see view_synthesis_prepare_command.cc).
 #pragma once
 
+#include "colmap_ext/reconstruction.h"
+
 #include <set>
 #include <string>
 #include <vector>
@@ -35,6 +37,15 @@ bool LooksLikeVideoFrames(const std::vector<std::string>& names);
 // so no evaluation target leaks into the geometry.
 void WriteStereoConfigs(const std::string& workspace_path,
                         const std::set<std::string>& holdout, int max_sources = 20);
+
+// COLMAP's image_undistorter crops to the region where every pixel is valid and stops at
+// --min_scale 0.2. A distortion estimate that cannot be inverted at the image borders
+// (SIMPLE_RADIAL with a strong negative k1, whose r (1 + k1 r^2) folds back) shrinks the
+// images to a fifth: the scene stays usable but loses most pixels. One line per camera of
+// `undistorted` whose longest side is under half of what max_image_size allows.
+std::vector<std::string> ShrunkenUndistortionWarnings(
+    const colmap::Reconstruction& sfm, const colmap::Reconstruction& undistorted,
+    int max_image_size);
 
 void RunPrepareStages(const PrepareContext& context);
 
