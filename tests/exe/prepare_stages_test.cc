@@ -32,10 +32,12 @@ TEST(PrepareStages, RecognisesVideoFrames) {
 
 TEST(PrepareStages, WarnsWhenUndistortionShrinksTheImages) {
   colmap::Reconstruction sfm, undistorted;
-  sfm.cameras[1] = {1, 2, 800, 800, {562, 400, 400, -0.166}};  // ethiopian_head's estimate
+  sfm.cameras[1] = {
+      1, 2, 800, 800, {562, 400, 400, -0.166}};  // ethiopian_head's estimate
   sfm.cameras[2] = {2, 2, 1600, 1200, {1200, 800, 600, -0.01}};
   undistorted.cameras[1] = {1, 1, 160, 160, {112, 112, 80, 80}};  // COLMAP's min_scale
-  undistorted.cameras[2] = {2, 1, 780, 590, {590, 590, 390, 295}};  // at max_image_size 800
+  undistorted.cameras[2] = {
+      2, 1, 780, 590, {590, 590, 390, 295}};  // at max_image_size 800
   const std::vector<std::string> warnings =
       ShrunkenUndistortionWarnings(sfm, undistorted, 800);
   ASSERT_EQ(warnings.size(), 1u);

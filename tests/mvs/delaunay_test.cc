@@ -127,7 +127,8 @@ TEST(IsolatedPoints, FlagsOnlyPointsFarFromTheRest) {
   EXPECT_NEAR(spacing[31], (0.01 * 4 + 0.0) / 4, 1e-12);  // 4 neighbours at 1 cm
   IsolatedPointOptions options;
   const std::vector<bool> isolated = FindIsolatedPoints(points, options);
-  for (size_t i = 0; i < points.size(); ++i) EXPECT_EQ(isolated[i], i >= first_stray) << i;
+  for (size_t i = 0; i < points.size(); ++i)
+    EXPECT_EQ(isolated[i], i >= first_stray) << i;
   // Far from the origin: the same answer.
   for (auto& p : points) p += Eigen::Vector3d(3e4, -1e4, 2e3);
   EXPECT_EQ(FindIsolatedPoints(points, options), isolated);
@@ -154,7 +155,8 @@ TEST(DelaunayMesher, StrayPointsAnchorNoFaces) {
         lo + size.cwiseProduct(Eigen::Vector3d(c % 2 ? -0.25 : 1.25, 0.2 + 0.12 * c,
                                                c % 3 ? 1.2 : -0.2));
     for (int j = 0; j < 3; ++j) {
-      const Eigen::Vector3d p = centre + Eigen::Vector3d(0.004 * j, -0.003 * j, 0.002 * j);
+      const Eigen::Vector3d p =
+          centre + Eigen::Vector3d(0.004 * j, -0.003 * j, 0.002 * j);
       strays.push_back(p);
       cloud.input.points.push_back(p);
       cloud.input.visibility.push_back({0, 2, 4, 6, 8});

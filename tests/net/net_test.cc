@@ -200,8 +200,8 @@ TEST(FvsNetTest, RgbSkipStartsAsTheMeanOfTheSourcesThatSeeAPixel) {
   torch::NoGradGuard no_grad;
   const Inputs in = MakeInputs(3, 16, 24);
   const torch::Tensor encoded = net->Encode(in.images);
-  EXPECT_TRUE(torch::equal(encoded.narrow(1, net->config().feature_channels, 3),
-                           in.images));
+  EXPECT_TRUE(
+      torch::equal(encoded.narrow(1, net->config().feature_channels, 3), in.images));
   const torch::Tensor warped_rgb = WarpFeatures(in.images, in.grid);
   const torch::Tensor w = torch::exp(prior * (in.valid_warp - 1));
   const torch::Tensor expected =
@@ -210,12 +210,11 @@ TEST(FvsNetTest, RgbSkipStartsAsTheMeanOfTheSourcesThatSeeAPixel) {
   EXPECT_LT((out.rgb - expected).abs().max().item<float>(), 1e-5f);
   EXPECT_LT((out.per_source_rgb - warped_rgb).abs().max().item<float>(), 1e-6f);
   // The option is refused where it has no per-source colours to correct.
-  EXPECT_THROW(
-      ModelConfig::FromJson(R"({"variant":"fvs_single","rgb_skip":true})"), Error);
-  EXPECT_THROW(
-      ModelConfig::FromJson(R"({"variant":"fvs_nomasks","mask_prior":2})"), Error);
-  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_fast","mask_prior":-1})"),
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_single","rgb_skip":true})"),
                Error);
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_nomasks","mask_prior":2})"),
+               Error);
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_fast","mask_prior":-1})"), Error);
 }
 
 TEST(SoftmaxWeightsTest, FiniteAndNormalisedAtExtremes) {

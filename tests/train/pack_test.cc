@@ -12,8 +12,8 @@
 #include <random>
 #include <set>
 
-#include "fvs/scene/source_selection.h"
 #include "fvs/net/net.h"
+#include "fvs/scene/source_selection.h"
 #include "fvs/scene/warp.h"
 #include "fvs/train/data.h"
 #include "fvs/train/train_options.h"

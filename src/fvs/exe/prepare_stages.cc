@@ -25,8 +25,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-
-
 const char* kWho = "colmap view_synthesis_prepare";
 
 // FNV-1a: a stable digest for chaining fingerprints (std::hash is not stable across

@@ -1,11 +1,11 @@
 // The stages of view_synthesis_prepare (see view_synthesis_prepare_command.cc).
 #pragma once
 
-#include "colmap_ext/reconstruction.h"
-
 #include <set>
 #include <string>
 #include <vector>
+
+#include "colmap_ext/reconstruction.h"
 
 namespace fvs {
 

@@ -1,7 +1,6 @@
 // The CGAL / Boost.Graph part of the Delaunay graph-cut mesher (see delaunay.h). This is
 // the only translation unit that includes CGAL: it compiles slowly and needs much memory.
 #include "fvs/mvs/delaunay.h"
-#include "fvs/mvs/isolated_points.h"
 
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Delaunay_triangulation_cell_base_3.h>
@@ -23,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "fvs/mvs/isolated_points.h"
 #include "fvs/util/error.h"
 #include "fvs/util/parallel.h"
 #include "fvs/util/progress.h"

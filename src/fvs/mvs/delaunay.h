@@ -108,14 +108,14 @@ struct DelaunayMeshingInput {
 
 struct DelaunayMeshingStats {
   size_t num_input_points = 0;
-  size_t num_isolated_points = 0;  // dropped before triangulation
-  size_t num_vertices = 0;        // triangulation vertices (after merging)
-  size_t num_cells = 0;           // including infinite cells
-  size_t num_rays = 0;            // (vertex, image) rays cast
-  size_t num_ray_steps = 0;       // facets crossed by all rays
-  size_t num_surface_facets = 0;  // before the long-edge filter
+  size_t num_isolated_points = 0;   // dropped before triangulation
+  size_t num_vertices = 0;          // triangulation vertices (after merging)
+  size_t num_cells = 0;             // including infinite cells
+  size_t num_rays = 0;              // (vertex, image) rays cast
+  size_t num_ray_steps = 0;         // facets crossed by all rays
+  size_t num_surface_facets = 0;    // before the long-edge filter
   size_t num_spacing_filtered = 0;  // faces dropped by max_side_spacing_factor
-  size_t num_faces = 0;           // in the output mesh
+  size_t num_faces = 0;             // in the output mesh
   size_t num_mesh_vertices = 0;
   double distance_sigma = 0;
   double max_side_length = 0;  // the long-edge filter's threshold

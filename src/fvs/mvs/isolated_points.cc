@@ -54,10 +54,9 @@ class KdTree {
     int axis = 0;
     (hi - lo).maxCoeff(&axis);
     const uint32_t mid = begin + (end - begin) / 2;
-    std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
-                     [&](uint32_t a, uint32_t b) {
-                       return points_[a][axis] < points_[b][axis];
-                     });
+    std::nth_element(
+        order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+        [&](uint32_t a, uint32_t b) { return points_[a][axis] < points_[b][axis]; });
     const double split = points_[order_[mid]][axis];
     const uint32_t left = Build(begin, mid);
     const uint32_t right = Build(mid, end);

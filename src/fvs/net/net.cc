@@ -253,8 +253,8 @@ BlendOutput FvsNetImpl::Blend(const torch::Tensor& warped,
   Require(warped.dim() == 4 && warped.size(0) > 0 &&
               warped.size(1) == config_.EncodedChannels(),
           kSubject,
-          "Blend expects warped features [K," + std::to_string(config_.EncodedChannels()) +
-              ",H,W], got " + Shape(warped));
+          "Blend expects warped features [K," +
+              std::to_string(config_.EncodedChannels()) + ",H,W], got " + Shape(warped));
   const int64_t k = warped.size(0), height = warped.size(2), width = warped.size(3);
   if (config_.use_masks) {
     Require(valid_depth.defined() && valid_depth.dim() == 4 && valid_depth.size(0) == 1 &&
@@ -300,9 +300,10 @@ BlendOutput FvsNetImpl::Blend(const torch::Tensor& warped,
       }
       torch::Tensor confidence = confidence_head_(top);
       if (config_.mask_prior > 0) {
-        confidence = confidence +
-                     config_.mask_prior *
-                         (valid_warp.narrow(0, first, count).to(confidence.options()) - 1);
+        confidence =
+            confidence +
+            config_.mask_prior *
+                (valid_warp.narrow(0, first, count).to(confidence.options()) - 1);
       }
       rgbs.push_back(rgb);
       confidences.push_back(confidence);

@@ -255,10 +255,14 @@ void CropSourcesToFootprint(TrainingSample* sample, int margin, int multiple) {
       continue;
     }
     const torch::Tensor us = u[i].masked_select(m), vs = v[i].masked_select(m);
-    x0[i] = std::max<int64_t>(0, static_cast<int64_t>(std::floor(us.min().item<double>())) - margin);
-    y0[i] = std::max<int64_t>(0, static_cast<int64_t>(std::floor(vs.min().item<double>())) - margin);
-    x1[i] = std::min<int64_t>(width, static_cast<int64_t>(std::ceil(us.max().item<double>())) + margin);
-    y1[i] = std::min<int64_t>(height, static_cast<int64_t>(std::ceil(vs.max().item<double>())) + margin);
+    x0[i] = std::max<int64_t>(
+        0, static_cast<int64_t>(std::floor(us.min().item<double>())) - margin);
+    y0[i] = std::max<int64_t>(
+        0, static_cast<int64_t>(std::floor(vs.min().item<double>())) - margin);
+    x1[i] = std::min<int64_t>(
+        width, static_cast<int64_t>(std::ceil(us.max().item<double>())) + margin);
+    y1[i] = std::min<int64_t>(
+        height, static_cast<int64_t>(std::ceil(vs.max().item<double>())) + margin);
     box_w = std::max(box_w, x1[i] - x0[i]);
     box_h = std::max(box_h, y1[i] - y0[i]);
   }
@@ -272,12 +276,12 @@ void CropSourcesToFootprint(TrainingSample* sample, int margin, int multiple) {
     const int64_t oy = std::clamp<int64_t>(y0[i], 0, height - box_h);
     crops.push_back(sample->source_rgb[i].index(
         {Slice(), Slice(oy, oy + box_h), Slice(ox, ox + box_w)}));
-    grids.push_back(torch::stack({(u[i] - ox) * (2.0 / box_w) - 1,
-                                  (v[i] - oy) * (2.0 / box_h) - 1},
-                                 2));
+    grids.push_back(torch::stack(
+        {(u[i] - ox) * (2.0 / box_w) - 1, (v[i] - oy) * (2.0 / box_h) - 1}, 2));
   }
   sample->source_rgb = torch::stack(crops).contiguous();
-  sample->warp.grid = torch::stack(grids).to(sample->warp.grid.scalar_type()).contiguous();
+  sample->warp.grid =
+      torch::stack(grids).to(sample->warp.grid.scalar_type()).contiguous();
 }
 
 void ApplyColorJitter(const ColorJitter& j, TrainingSample* sample) {
