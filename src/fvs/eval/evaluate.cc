@@ -1,0 +1,184 @@
+#include "fvs/eval/evaluate.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "colmap_ext/image_io.h"
+#include "fvs/eval/draw.h"
+#include "fvs/eval/metrics.h"
+#include "fvs/render/targets.h"
+#include "fvs/scene/scene.h"
+#include "fvs/util/error.h"
+#include "fvs/util/machine.h"
+#include "fvs/util/progress.h"
+
+namespace fvs::eval {
+namespace {
+
+std::string FormatScale(double scale) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", scale);
+  return text;
+}
+
+// Image names may hold '/': flatten them for file names.
+std::string FileStem(const std::string& name) {
+  std::string stem = name;
+  for (char& c : stem) {
+    if (c == '/' || c == '\\' || c == ' ') c = '_';
+  }
+  const size_t dot = stem.rfind('.');
+  return dot == std::string::npos || dot == 0 ? stem : stem.substr(0, dot);
+}
+
+Image Thumbnail(const Image& image, int width) {
+  const int height =
+      std::max(1, static_cast<int>(std::lround(static_cast<double>(width) * image.height /
+                                               std::max(1, image.width))));
+  return ResizeImage(image, width, height);
+}
+
+}  // namespace
+
+std::string EvalConfig::Label() const {
+  std::string label =
+      method + " K=" + std::to_string(num_sources) + " s=" + FormatScale(scale);
+  if (precision != "fp32") label += " " + precision;
+  return label;
+}
+
+std::string EvalConfig::Slug() const {
+  std::string slug =
+      method + "_k" + std::to_string(num_sources) + "_s" + FormatScale(scale);
+  if (precision != "fp32") slug += "_" + precision;
+  for (char& c : slug) {
+    if (c == '.') c = 'p';
+  }
+  return slug;
+}
+
+void PreloadPhotos(const Scene& scene,
+                   std::vector<std::pair<int, std::string>>* bad_photos) {
+  bad_photos->clear();
+  for (int i = 0; i < scene.num_views(); ++i) {
+    try {
+      scene.SourceImage(i);
+    } catch (const std::exception& e) {
+      bad_photos->emplace_back(i, e.what());
+    }
+  }
+}
+
+std::vector<ViewResult> EvaluateTargets(
+    const Scene& scene, const TargetSet& set, const std::vector<EvalTarget>& targets,
+    const EvalConfig& config, const EvalRunOptions& options,
+    const std::vector<std::pair<int, std::string>>& bad_photos,
+    std::vector<ViewThumbnails>* thumbnails) {
+  RenderOptions render = options.render;
+  render.num_sources = config.num_sources;
+  render.model_path = config.model_path;
+  std::unique_ptr<Method> method = CreateMethod(config.method, render);
+
+  // Sources no target may use: the withheld set and photos that cannot be read.
+  std::vector<int> shared_exclude;
+  std::set<int> bad;
+  for (const auto& [index, error] : bad_photos) {
+    shared_exclude.push_back(index);
+    bad.insert(index);
+  }
+  for (const std::string& name : set.excluded_sources) {
+    const int index = scene.FindView(name);
+    if (index >= 0 && !bad.count(index)) shared_exclude.push_back(index);
+  }
+  if (!options.write_images_dir.empty()) {
+    std::filesystem::create_directories(options.write_images_dir + "/" + config.Slug());
+  }
+
+  std::vector<ViewResult> results;
+  std::unique_ptr<Progress> progress;
+  if (options.show_progress) {
+    progress = std::make_unique<Progress>("evaluate " + config.Label(),
+                                          static_cast<int64_t>(targets.size()));
+  }
+  for (const EvalTarget& target : targets) {
+    ViewResult r;
+    r.scene = options.scene_name;
+    r.config = config;
+    r.protocol = set.protocol;
+    r.target = target.name;
+    r.geometry_holdout = target.geometry_holdout;
+    r.error = target.error;
+    const int index = r.ok() ? scene.FindView(target.name) : -1;
+    if (r.ok() && index < 0) r.error = "not a registered image of the model";
+    if (r.ok()) {
+      try {
+        const Image& truth = scene.SourceImage(index);  // throws for a bad photo
+        r.width = truth.width;
+        r.height = truth.height;
+        TargetView view;
+        view.name = target.name;
+        view.camera = ResizeTarget(scene.view(index).camera, 0, 0, config.scale);
+        view.exclude_views = shared_exclude;
+        view.exclude_views.push_back(index);
+
+        Timer timer;
+        const double cpu_start = ProcessCpuSeconds();
+        const RenderResult result = method->Render(scene, view);
+        Image prediction = result.color;
+        if (prediction.width != truth.width || prediction.height != truth.height) {
+          prediction = ResizeImage(prediction, truth.width, truth.height);
+        }
+        r.seconds = timer.Seconds();
+        r.cpu_seconds = ProcessCpuSeconds() - cpu_start;
+        prediction = QuantizeTo8Bit(prediction);
+
+        r.psnr = Psnr(prediction, truth);
+        r.ssim = Ssim(prediction, truth);
+        if (options.lpips) r.lpips = options.lpips(prediction, truth);
+        Image covered_mask = result.coverage;
+        if (covered_mask.width != truth.width || covered_mask.height != truth.height) {
+          covered_mask = ResizeImage(covered_mask, truth.width, truth.height);
+        }
+        try {
+          r.psnr_covered = Psnr(prediction, truth, &covered_mask);
+          r.ssim_covered = Ssim(prediction, truth, &covered_mask);
+        } catch (const Error&) {
+          // Nothing covered: the covered-only numbers do not exist.
+        }
+        r.sources_used = static_cast<int>(result.sources.size());
+        double covered = 0;
+        for (float c : result.coverage.data) covered += c;
+        r.coverage = covered / std::max<size_t>(1, result.coverage.data.size());
+        Require(std::isfinite(r.psnr) && std::isfinite(r.ssim), target.name,
+                "metrics are not finite (NaN or Inf in the rendered image)");
+        if (!options.write_images_dir.empty()) {
+          colmap::WriteImage(options.write_images_dir + "/" + config.Slug() + "/" +
+                                 FileStem(target.name) + ".png",
+                             prediction);
+        }
+        if (thumbnails && options.thumbnail_width > 0) {
+          thumbnails->push_back({target.name,
+                                 Thumbnail(prediction, options.thumbnail_width),
+                                 Thumbnail(truth, options.thumbnail_width)});
+        }
+      } catch (const std::exception& e) {
+        r.error = e.what();
+        r.psnr = r.ssim = r.lpips = r.seconds = r.cpu_seconds = r.coverage =
+            kNotAvailable;
+        r.psnr_covered = r.ssim_covered = kNotAvailable;
+      }
+    }
+    if (!r.ok()) {
+      std::fprintf(stderr, "WARNING: %s [%s]: %s\n", r.target.c_str(),
+                   config.Label().c_str(), r.error.c_str());
+    }
+    results.push_back(std::move(r));
+    if (progress) progress->Advance();
+  }
+  if (progress) progress->Finish();
+  return results;
+}
+
+}  // namespace fvs::eval

@@ -1,0 +1,103 @@
+// Renders the targets of a protocol with one method configuration and scores them
+// against the photos: PSNR, SSIM (and LPIPS when its weights were given), the wall time
+// of each view, and the sources actually used. Predictions are quantised to 8 bits
+// first (the paper's protocol); a target rendered at a reduced resolution scale is
+// upsampled (bilinear) to the photo's size, so that every configuration answers the same
+// question: how close to the photo, at what cost.
+//
+// One bad view never stops the others: its row carries the error (a photo of the wrong
+// size, a name not in the model, a render that failed), and a photo that cannot be read
+// is also kept out of every target's sources.
+#pragma once
+
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "fvs/eval/protocol.h"
+#include "fvs/render/method.h"
+#include "fvs/util/image.h"
+
+namespace fvs {
+class Scene;
+}
+
+namespace fvs::eval {
+
+// One point of an evaluation (or of a sweep): method, K, resolution scale, precision.
+struct EvalConfig {
+  std::string method = "ulr";
+  int num_sources = 5;
+  double scale = 1.0;
+  // The renderer computes in float32 on the CPU; the column exists so that results of
+  // other precisions (GPU fp16) merge into the same tables.
+  std::string precision = "fp32";
+  std::string model_path;  // network methods
+
+  // "ulr K=5 s=1", unique per (method, K, scale, precision).
+  std::string Label() const;
+  // A file-name-safe form of Label(): "ulr_k5_s1".
+  std::string Slug() const;
+};
+
+constexpr double kNotAvailable = std::numeric_limits<double>::quiet_NaN();
+
+struct ViewResult {
+  std::string scene;
+  EvalConfig config;
+  std::string protocol;
+  std::string target;
+  bool geometry_holdout = false;
+  std::string error;  // empty: evaluated
+  double psnr = kNotAvailable;
+  double ssim = kNotAvailable;
+  double lpips = kNotAvailable;  // NaN: not available (no weights), never a guess
+  // The same over the pixels some source contributed to (diagnostic: where the proxy
+  // geometry has no surface, e.g. the sky, no method has anything to show). n/a when
+  // nothing is covered. The protocol's numbers are the full-image ones above.
+  double psnr_covered = kNotAvailable;
+  double ssim_covered = kNotAvailable;
+  double seconds = kNotAvailable;  // wall time of the render (+ upsampling)
+  // CPU seconds of the process (all threads) over the same span: on a shared machine the
+  // wall time depends on the load, the CPU time much less.
+  double cpu_seconds = kNotAvailable;
+  int sources_used = 0;
+  double coverage = kNotAvailable;  // fraction of pixels some source contributed to
+  int width = 0, height = 0;        // the photo's size (metrics are computed at it)
+
+  bool ok() const { return error.empty(); }
+};
+
+// Thumbnails for the contact sheet (rendered beside the photo).
+struct ViewThumbnails {
+  std::string target;
+  Image rendered, truth;
+};
+
+// LPIPS distance of (prediction, truth) in [0, 1] RGB; empty = not available.
+using PerceptualDistance = std::function<double(const Image&, const Image&)>;
+
+struct EvalRunOptions {
+  RenderOptions render;  // K and model path are taken from the config
+  PerceptualDistance lpips;
+  int thumbnail_width = 0;       // > 0: collect thumbnails of this width
+  std::string write_images_dir;  // non-empty: write <dir>/<slug>/<target>.png
+  std::string scene_name;        // the "scene" column
+  bool show_progress = true;
+};
+
+// Loads every photo once (so that no view's time includes reading files) and returns the
+// views whose photo cannot be used, with the reason, in *bad_photos (index -> error).
+void PreloadPhotos(const Scene& scene,
+                   std::vector<std::pair<int, std::string>>* bad_photos);
+
+// Evaluates `targets` (already sharded) with one configuration. Never throws for a bad
+// view; throws fvs::Error only when the method cannot be created at all.
+std::vector<ViewResult> EvaluateTargets(
+    const Scene& scene, const TargetSet& set, const std::vector<EvalTarget>& targets,
+    const EvalConfig& config, const EvalRunOptions& options,
+    const std::vector<std::pair<int, std::string>>& bad_photos,
+    std::vector<ViewThumbnails>* thumbnails = nullptr);
+
+}  // namespace fvs::eval

@@ -1,0 +1,66 @@
+// The stability suite (view_synthesis_stability): every case renders without NaN or Inf
+// and the same 10 km from the origin, with the classical methods and the network (random
+// fvs_fast weights: stability does not need trained ones), in-process and through the
+// front door (FrontDoorBinary()).
+#include "fvs/eval/stability.h"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include "fvs/net/net.h"
+#include "support/test_support.h"
+
+namespace fvs::eval {
+namespace {
+
+TEST(Stability, EveryCaseIsFiniteAndTranslationInvariant) {
+  testing::TempDir dir;
+  torch::manual_seed(3);
+  const ModelConfig config = ModelConfig::ForVariant("fvs_fast");
+  FvsNet net(config);
+  StabilityOptions options;
+  options.model_path = dir / "fvs_fast.safetensors";
+  SaveWeights(net, config, options.model_path, /*fp16=*/false);
+  options.methods = {"nearest", "ulr", "fvs_fast"};
+  options.width = 40;
+  options.height = 30;
+  const std::vector<StabilityResult> results = RunStabilitySuite(options);
+  ASSERT_EQ(results.size(), StabilityCaseNames().size() * 3);
+  for (const StabilityResult& r : results) {
+    const std::string what = r.case_name + " / " + r.method;
+    EXPECT_TRUE(r.error.empty()) << what << ": " << r.error;
+    EXPECT_EQ(r.nan_count, 0) << what;
+    EXPECT_EQ(r.inf_count, 0) << what;
+    EXPECT_LE(r.max_deviation, 1.0 / 255) << what;
+    EXPECT_GT(r.seconds, 0.0) << what;
+    if (r.case_name == "reference" || r.case_name == "k_too_large") {
+      EXPECT_GT(r.covered, 0.5) << what;  // an ordinary view is mostly covered
+    }
+    if (r.case_name == "depth_0" || r.case_name == "behind_sources") {
+      EXPECT_LT(r.covered, 0.05) << what;  // nothing there to take colour from
+    }
+  }
+}
+
+TEST(Stability, CommandPrintsTheTable) {
+  testing::TempDir dir;
+  std::string output;
+  ASSERT_EQ(
+      testing::RunShell("FVS_QUIET=1 " + testing::FrontDoorBinary() +
+                            " view_synthesis_stability --methods nearest --width 32 "
+                            "--height 24 --output_path " +
+                            dir.path(),
+                        &output),
+      0)
+      << output;
+  for (const std::string& name : StabilityCaseNames()) {
+    EXPECT_NE(output.find(name), std::string::npos) << output;
+  }
+  EXPECT_NE(output.find("max_dev_far"), std::string::npos) << output;
+  EXPECT_NE(output.find("nproc"), std::string::npos) << output;
+  EXPECT_NE(testing::ReadTextFile(dir / "stability.md").find("| depth_1e30 | nearest |"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace fvs::eval
