@@ -41,8 +41,24 @@ if ls models/*.safetensors >/dev/null 2>&1; then
     --output_path "$OUT/novel_views_fvs" --method fvs --model_path "$model" --interpolate 4
 fi
 
+# 4. A short fly-through: a Ceres-smoothed path through five registered cameras, rendered
+#    with temporally stable sources, encoded to H.264 when ffmpeg can be installed (the
+#    frames and frame_report.csv are written either way).
+scripts/install_deps.sh ffmpeg || echo "demo: ffmpeg could not be installed; the fly-through stays frames only"
+mapfile -t names < <(ls "$OUT/workspace/images" | sort)
+step=$(( (${#names[@]} - 1) / 4 )); (( step < 1 )) && step=1
+keys=""
+for (( i = 0; i < ${#names[@]}; i += step )); do keys+="${keys:+,}${names[$i]}"; done
+"$COLMAP" view_synthesis_path --workspace_path "$OUT/workspace" \
+  --output_path "$OUT/flythrough/camera_path.json" --keyframes "$keys" \
+  --fps 12 --seconds_per_keyframe 1.5 --images_txt "$OUT/flythrough/model/images.txt"
+"$COLMAP" view_synthesis --workspace_path "$OUT/workspace" --method ulr \
+  --camera_path "$OUT/flythrough/camera_path.json" --output_path "$OUT/flythrough/frames" \
+  --stable_sources 1 --video "$OUT/flythrough/flythrough.mp4"
+
 echo
 echo "demo: done in $(( $(date +%s) - start )) s"
 echo "  photos:       $OUT/synthetic/images"
 echo "  workspace:    $OUT/workspace (sparse/, stereo/, fused.ply, meshed-delaunay.ply)"
 echo "  novel views:  $OUT/novel_views_ulr"
+echo "  fly-through:  $OUT/flythrough (camera_path.json, frames/, frame_report.csv, flythrough.mp4 with ffmpeg)"

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages colmap-fvs needs (only those missing). Idempotent; fast when
-# everything is there. Runs apt as root or through sudo.
+# everything is there. Runs apt as root or through sudo. Arguments name extra, optional
+# packages (scripts/demo.sh asks for ffmpeg this way; the build and tests never need it).
 set -euo pipefail
 
 PACKAGES=(
@@ -12,6 +13,9 @@ PACKAGES=(
   qtbase5-dev libqt5opengl5-dev xvfb xauth
   libgtest-dev libsqlite3-dev nlohmann-json3-dev
 )
+if [[ $# -gt 0 ]]; then
+  PACKAGES=("$@")
+fi
 if [[ "${FVS_NO_GUI:-0}" == "1" ]]; then
   PACKAGES=("${PACKAGES[@]/qtbase5-dev}")
   PACKAGES=("${PACKAGES[@]/libqt5opengl5-dev}")

@@ -3,22 +3,42 @@
 //            --interpolate N
 //   --method ulr|nearest|fvs, --num_sources K, --width/--height/--scale,
 //   --write_depth, --write_confidence, --write_sources
+//   videos: --video out.mp4 (ffmpeg when installed), --fps, --stable_sources 1
+//   (--source_hysteresis, --stable_source_order), --temporal_blend a, --flag_coverage c
 // Renders every target into O/<name>.png (plus the optional extras, see render_output.h)
-// and prints a per-target timing summary (depth / selection / warp / blend).
+// and prints a per-target timing summary (depth / selection / warp / blend). A target
+// whose PNG already exists (and has the right size) is skipped unless --overwrite 1, so
+// an interrupted render resumes at the first missing frame. O/frame_report.{csv,json}
+// hold per frame the coverage (flagged under --flag_coverage), the sources and the
+// flicker to the previous frame (fvs/path/flicker.h).
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "colmap_ext/image_io.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/option_manager.h"
+#include "fvs/path/frame_report.h"
+#include "fvs/path/temporal.h"
+#include "fvs/path/video.h"
 #include "fvs/render/method.h"
 #include "fvs/render/render_output.h"
 #include "fvs/render/targets.h"
 #include "fvs/scene/scene.h"
+#include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
+#include "fvs/util/machine.h"
+#include "fvs/util/manifest.h"
 #include "fvs/util/progress.h"
+#include "fvs/util/shard.h"
+#include "fvs/util/string_util.h"
 
 namespace fvs {
 namespace {
@@ -35,8 +55,15 @@ struct ViewSynthesisOptions {
   int height = 0;
   double scale = 1.0;
   bool holdout = false;
+  std::string shard;  // "i/n": every n-th target from i (batch array jobs)
   RenderOptions render;
   RenderOutputOptions output;
+  // Videos.
+  std::string video;
+  double fps = 0;  // 0: the camera path's "fps", else 30
+  bool overwrite = false;
+  bool stable_sources = false;
+  TemporalOptions temporal;
 
   void Check() const {
     const int given =
@@ -49,8 +76,62 @@ struct ViewSynthesisOptions {
     Require(width >= 0 && height >= 0, "colmap view_synthesis",
             "--width and --height must not be negative");
     render.Check();
+    temporal.Check();
+    Require(std::isfinite(fps) && fps >= 0, "--fps", "must not be negative");
+    Shard::Parse(shard);
   }
 };
+
+// A finished frame: its PNG exists and has the size the target would have.
+bool FrameDone(const std::string& png, const PinholeCamera& camera) {
+  if (!std::filesystem::exists(png)) return false;
+  try {
+    int w = 0, h = 0;
+    colmap::ReadImageSize(png, &w, &h);
+    if (w != camera.width || h != camera.height) return false;
+    colmap::ReadImage(png);  // decodes: a truncated file fails here
+    return true;
+  } catch (const Error&) {
+    return false;
+  }
+}
+
+double CameraPathFps(const std::string& path) {
+  try {
+    std::ifstream in(path);
+    const nlohmann::json json = nlohmann::json::parse(in);
+    const double fps = json.value("fps", 0.0);
+    return std::isfinite(fps) && fps > 0 ? fps : 0.0;
+  } catch (const std::exception&) {
+    return 0.0;
+  }
+}
+
+// What decides the pixels of a frame: a frame rendered with other settings is not
+// resumed.
+std::string RenderSettings(const ViewSynthesisOptions& o) {
+  nlohmann::json json;
+  json["method"] = o.method;
+  json["model_path"] = o.render.model_path;
+  json["num_sources"] = o.render.num_sources;
+  json["selection_tolerance"] = o.render.selection_tolerance;
+  json["warp_tolerance"] = o.render.warp_tolerance;
+  json["width"] = o.width;
+  json["height"] = o.height;
+  json["scale"] = o.scale;
+  json["holdout"] = o.holdout;
+  json["source_hysteresis"] = o.render.source_hysteresis;
+  json["stable_source_order"] = o.render.stable_source_order;
+  json["temporal_blend"] = o.temporal.temporal_blend;
+  json["targets"] = !o.target_images.empty() ? "target_images " + o.target_images
+                    : !o.camera_path.empty() ? "camera_path " + o.camera_path
+                    : o.orbit > 0            ? "orbit " + std::to_string(o.orbit)
+                                  : "interpolate " + std::to_string(o.interpolate);
+  // A changed target file (same name) is a different render too.
+  const std::string file = !o.target_images.empty() ? o.target_images : o.camera_path;
+  if (!file.empty()) json["targets_stamp"] = StampPaths({file});
+  return json.dump(2) + "\n";
+}
 
 std::vector<TargetCamera> LoadTargets(const ViewSynthesisOptions& o, const Scene& scene) {
   if (!o.target_images.empty()) return ReadTargetImagesTxt(o.target_images, scene);
@@ -93,60 +174,196 @@ int RunViewSynthesis(int argc, char** argv) {
   options.AddDefault("write_sources", &o.output.write_sources,
                      "also write <name>.sources.json");
   options.AddDefault("num_threads", &o.render.num_threads, "threads (0: all cores)");
+  options.AddDefault(
+      "video", &o.video,
+      "also encode the frames into this H.264 mp4 (needs ffmpeg on the PATH "
+      "or FVS_FFMPEG; without it only the frames are written)");
+  options.AddDefault("fps", &o.fps, "video frame rate (0: the camera path's, else 30)");
+  options.AddDefault(
+      "overwrite", &o.overwrite,
+      "render every target again (default: skip targets whose PNG exists)");
+  options.AddDefault("stable_sources", &o.stable_sources,
+                     "temporally stable sources: --source_hysteresis 0.1 (unless given) "
+                     "and --stable_source_order 1");
+  options.AddDefault("source_hysteresis", &o.render.source_hysteresis,
+                     "keep the previous frame's sources unless another sees this much "
+                     "more (0.1 = 10%); 0: off");
+  options.AddDefault("stable_source_order", &o.render.stable_source_order,
+                     "blend the sources in view order, not best first");
+  options.AddDefault("temporal_blend", &o.temporal.temporal_blend,
+                     "share of the previous output, warped into the frame, where the "
+                     "geometry agrees (0: off)");
+  options.AddDefault("flag_coverage", &o.temporal.coverage_threshold,
+                     "frames with less coverage are flagged in frame_report.csv");
+  options.AddDefault("shard", &o.shard,
+                     "i/n: render only targets i, i+n, i+2n, ... (Slurm/Kubernetes array "
+                     "jobs; file names stay those of the full path)");
   if (!options.Parse(argc, argv)) return 0;
+  if (o.stable_sources) {
+    if (o.render.source_hysteresis == 0) o.render.source_hysteresis = 0.1;
+    o.render.stable_source_order = true;
+  }
   o.Check();
+  if (o.fps == 0) {
+    o.fps = o.camera_path.empty() ? 0.0 : CameraPathFps(o.camera_path);
+    if (o.fps == 0) o.fps = 30;
+  }
 
   // Before the (slow) scene load: an unusable method fails at once.
   std::unique_ptr<Method> method = CreateMethod(o.method, o.render);
   Scene scene = Scene::Load(o.workspace_path, {true, o.render.num_threads});
-  const std::vector<TargetCamera> targets = LoadTargets(o, scene);
+  std::vector<TargetCamera> targets = LoadTargets(o, scene);
+  if (const Shard shard = Shard::Parse(o.shard); !shard.IsAll()) {
+    std::vector<TargetCamera> mine;
+    for (int i : shard.Items(static_cast<int>(targets.size()))) mine.push_back(targets[i]);
+    if (mine.empty()) {
+      std::printf("shard %s: no targets (the path has %zu)\n", o.shard.c_str(),
+                  targets.size());
+      return 0;
+    }
+    targets = std::move(mine);
+  }
   std::error_code ec;
   std::filesystem::create_directories(o.output_path, ec);
   Require(!ec, o.output_path, "cannot create the output folder: " + ec.message());
 
+  // Resume: the frames already on disk are skipped (their report rows are kept), when
+  // they were rendered with the same settings (recorded before the first frame, so a
+  // killed run has them too).
+  const std::string settings = RenderSettings(o);
+  const std::string settings_path = JoinPaths(o.output_path, "render_settings.json");
+  bool overwrite = o.overwrite;
+  if (!overwrite) {
+    std::string previous;
+    try {
+      previous = ReadFileToString(settings_path);
+    } catch (const Error&) {
+    }
+    if (previous != settings) {
+      overwrite = true;
+      if (!previous.empty()) {
+        std::printf(
+            "the render settings differ from those of the frames in %s: "
+            "rendering every target again\n",
+            o.output_path.c_str());
+      }
+    }
+  }
+  WriteFileAtomic(settings_path, [&](std::ostream& out) { out << settings; });
+  std::vector<PinholeCamera> cameras;
+  int64_t to_render = 0;
+  std::vector<bool> done;
+  for (const TargetCamera& t : targets) {
+    cameras.push_back(ResizeTarget(t.camera, o.width, o.height, o.scale));
+    done.push_back(!overwrite &&
+                   FrameDone(JoinPaths(o.output_path, t.name + ".png"), cameras.back()));
+    to_render += !done.back();
+  }
+  if (to_render < static_cast<int64_t>(targets.size())) {
+    std::printf(
+        "resuming: %zu of %zu frames already rendered (--overwrite 1 redoes them)\n",
+        targets.size() - to_render, targets.size());
+  }
+  // Shards of one render write their own reports.
+  std::string report_stem = JoinPaths(o.output_path, "frame_report");
+  if (!o.shard.empty() && !Shard::Parse(o.shard).IsAll()) {
+    std::string tag = o.shard;
+    std::replace(tag.begin(), tag.end(), '/', '_');
+    report_stem += ".shard_" + tag;
+  }
+  const std::map<std::string, FrameReportRow> earlier =
+      overwrite ? std::map<std::string, FrameReportRow>()
+                : ReadFrameReport(report_stem + ".csv");
+  nlohmann::json report_extra = nlohmann::json::parse(settings);
+  report_extra["machine"] = DescribeMachine();
+  TemporalSequence sequence(o.temporal);
+  std::vector<FrameReportRow> report;
   std::vector<RenderTimings> timings;
   std::vector<double> coverage;
-  Progress progress("view_synthesis " + o.method, static_cast<int64_t>(targets.size()));
-  for (const TargetCamera& t : targets) {
+  std::vector<size_t> rendered;  // indices into targets
+  Progress progress("view_synthesis " + o.method, to_render);
+  for (size_t k = 0; k < targets.size(); ++k) {
+    const TargetCamera& t = targets[k];
+    if (done[k]) {
+      sequence.Reset();
+      const auto it = earlier.find(t.name);
+      FrameReportRow row = it != earlier.end() ? it->second : FrameReportRow();
+      row.frame = t.name;
+      row.status = "resumed";
+      report.push_back(row);
+      continue;
+    }
     TargetView view;
     view.name = t.name;
-    view.camera = scene.ToSceneCamera(ResizeTarget(t.camera, o.width, o.height, o.scale));
+    view.camera = scene.ToSceneCamera(cameras[k]);
     Require(view.camera.IsValid(), t.name, "invalid target camera");
     if (o.holdout && !t.image_name.empty()) {
       const int index = scene.FindView(t.image_name);
       if (index >= 0) view.exclude_views.push_back(index);
     }
-    const RenderResult result = method->Render(scene, view);
+    sequence.PrepareView(&view);
+    Timer frame_timer;
+    RenderResult result = method->Render(scene, view);
+    FrameReportRow row = sequence.Finish(view, &result);
     WriteRenderOutputs(o.output_path, t.name, o.method, scene, result, o.output);
+    row.seconds = frame_timer.Seconds();
+    report.push_back(row);
     timings.push_back(result.timings);
-    double covered = 0;
-    for (float c : result.coverage.data) covered += c;
-    coverage.push_back(covered / std::max<size_t>(1, result.coverage.data.size()));
+    coverage.push_back(row.coverage);
+    rendered.push_back(k);
+    // Every frame, so that a killed run keeps the rows of what it finished.
+    WriteFrameReport(report_stem, report,
+                     SummariseFrameReport(report, o.temporal.coverage_threshold),
+                     report_extra.dump());
     progress.Advance();
   }
   progress.Finish();
+  const FrameReportSummary summary =
+      SummariseFrameReport(report, o.temporal.coverage_threshold);
+  WriteFrameReport(report_stem, report, summary, report_extra.dump());
 
   std::printf("scene: %d views, loaded in %.2f s (%d source depths computed)\n",
               scene.num_views(), scene.load_seconds(), scene.num_depths_computed());
   std::printf("%-24s %8s %8s %8s %8s %8s %8s %9s\n", "target", "total_s", "depth_s",
               "select_s", "warp_s", "encode_s", "blend_s", "coverage");
   RenderTimings sum;
-  for (size_t i = 0; i < targets.size(); ++i) {
+  for (size_t i = 0; i < rendered.size(); ++i) {
     const RenderTimings& t = timings[i];
     std::printf("%-24s %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.1f%%\n",
-                targets[i].name.c_str(), t.total(), t.depth_s, t.selection_s, t.warp_s,
-                t.encode_s, t.blend_s, 100 * coverage[i]);
+                targets[rendered[i]].name.c_str(), t.total(), t.depth_s, t.selection_s,
+                t.warp_s, t.encode_s, t.blend_s, 100 * coverage[i]);
     sum.depth_s += t.depth_s;
     sum.selection_s += t.selection_s;
     sum.warp_s += t.warp_s;
     sum.encode_s += t.encode_s;
     sum.blend_s += t.blend_s;
   }
-  const double n = static_cast<double>(targets.size());
+  const double n = static_cast<double>(std::max<size_t>(1, rendered.size()));
   std::printf("%-24s %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f\n", "mean", sum.total() / n,
               sum.depth_s / n, sum.selection_s / n, sum.warp_s / n, sum.encode_s / n,
               sum.blend_s / n);
-  std::printf("wrote %zu images to %s\n", targets.size(), o.output_path.c_str());
+  std::printf("wrote %zu images to %s (%zu resumed)\n", rendered.size(),
+              o.output_path.c_str(), targets.size() - rendered.size());
+  std::printf("frames: %d, mean coverage %.1f%%, %zu flagged under %.0f%%%s\n",
+              summary.num_frames, 100 * summary.mean_coverage, summary.flagged.size(),
+              100 * o.temporal.coverage_threshold,
+              summary.flagged.empty() ? "" : " (see frame_report.csv)");
+  if (summary.mean_flicker >= 0) {
+    std::printf(
+        "flicker: %.3f levels (mean |frame t+1 - warped frame t|, 8-bit), %.2f "
+        "source changes per frame, %.1f ms per frame (%.1f ms of it temporal "
+        "blend + flicker)\n",
+        summary.mean_flicker, summary.mean_source_changes, 1000 * summary.mean_seconds,
+        1000 * summary.mean_temporal_seconds);
+  }
+  if (!o.video.empty()) {
+    std::vector<std::string> frames;
+    for (const TargetCamera& t : targets) {
+      frames.push_back(JoinPaths(o.output_path, t.name + ".png"));
+    }
+    const VideoResult video = EncodeVideo(frames, o.fps, o.video);
+    std::printf("%s%s\n", video.written ? "" : "NOTE: ", video.note.c_str());
+  }
   return 0;
 }
 

@@ -23,6 +23,10 @@ struct TargetView {
   PinholeCamera camera;
   // Views of the scene never used as sources (e.g. the held-out view in an evaluation).
   std::vector<int> exclude_views;
+  // Sources of the previous frame of a video (view indices): with
+  // RenderOptions::source_hysteresis > 0 they are favoured in the top-K choice, so the
+  // source set does not flip back and forth between frames (flicker).
+  std::vector<int> preferred_sources;
 };
 
 struct RenderOptions {
@@ -35,6 +39,13 @@ struct RenderOptions {
   int ulr_num_blend = 4;   // ULR k-nearest: best sources blended per pixel
   int num_threads = 0;     // <= 0: DefaultNumThreads()
   std::string model_path;  // weights, for methods that need them
+  // Temporal stability (videos). A preferred source (TargetView::preferred_sources) ranks
+  // with its count times (1 + source_hysteresis): it stays in the top K until another
+  // source sees that much more. 0 = off (each frame on its own).
+  double source_hysteresis = 0;
+  // Feed the selected sources in view order rather than best first, so that the
+  // recurrent blend sees a fixed order while the set does not change.
+  bool stable_source_order = false;
   void Check() const;
 };
 

@@ -1,10 +1,29 @@
 #include "fvs/render/prepare.h"
 
+#include <algorithm>
+
 #include "fvs/scene/scene.h"
 #include "fvs/util/error.h"
 #include "fvs/util/progress.h"
 
 namespace fvs {
+
+std::vector<SourceScore> ApplySourceHysteresis(std::vector<SourceScore> ranked,
+                                               const std::vector<int>& preferred,
+                                               double hysteresis, int k) {
+  const auto boosted = [&](const SourceScore& s) {
+    const bool favoured =
+        std::find(preferred.begin(), preferred.end(), s.view_index) != preferred.end();
+    return static_cast<double>(s.count) * (favoured ? 1.0 + hysteresis : 1.0);
+  };
+  // Stable: equal boosted scores keep the selection's order (best count first).
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [&](const SourceScore& a, const SourceScore& b) {
+                     return boosted(a) > boosted(b);
+                   });
+  if (static_cast<int>(ranked.size()) > k) ranked.resize(k);
+  return ranked;
+}
 
 PreparedTarget PrepareTarget(const Scene& scene, const TargetView& target,
                              const RenderOptions& options) {
@@ -24,7 +43,21 @@ PreparedTarget PrepareTarget(const Scene& scene, const TargetView& target,
   selection.exclude = target.exclude_views;
   selection.stride = options.selection_stride;
   selection.num_threads = options.num_threads;
+  const bool hysteresis =
+      options.source_hysteresis > 0 && !target.preferred_sources.empty();
+  if (hysteresis) selection.k = std::max(1, scene.num_views());  // rank every source
   prepared.sources = SelectSources(scene, target.camera, prepared.depth, selection);
+  if (hysteresis) {
+    prepared.sources =
+        ApplySourceHysteresis(prepared.sources, target.preferred_sources,
+                              options.source_hysteresis, options.num_sources);
+  }
+  if (options.stable_source_order) {
+    std::sort(prepared.sources.begin(), prepared.sources.end(),
+              [](const SourceScore& a, const SourceScore& b) {
+                return a.view_index < b.view_index;
+              });
+  }
   prepared.timings.selection_s = timer.Seconds();
 
   timer.Restart();
