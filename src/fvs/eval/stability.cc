@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "fvs/geometry/quad_grid.h"
 #include "fvs/geometry/rasterizer.h"
 #include "fvs/scene/scene.h"
 #include "fvs/util/progress.h"
@@ -10,52 +11,26 @@
 namespace fvs::eval {
 namespace {
 
-// A (nu x nv) grid of quads with smoothly varying vertex colours (a texture to warp).
-void AddQuadGrid(TriangleMesh* mesh, const Eigen::Vector3d& corner,
-                 const Eigen::Vector3d& u, const Eigen::Vector3d& v, int nu, int nv) {
-  const int base = static_cast<int>(mesh->vertices.size());
-  for (int j = 0; j <= nv; ++j) {
-    for (int i = 0; i <= nu; ++i) {
-      const Eigen::Vector3d p = corner + u * (double(i) / nu) + v * (double(j) / nv);
-      mesh->vertices.push_back(p);
-      auto channel = [&](double a, double b, double c, double phase) {
-        const double s = 0.5 + 0.4 * std::sin(a * p.x() + b * p.y() + c * p.z() + phase);
-        return static_cast<uint8_t>(std::lround(255 * s));
-      };
-      mesh->colors.push_back(Vector3ub(channel(2.1, 1.3, 0.7, 0.0),
-                                       channel(0.9, 2.7, 1.9, 1.0),
-                                       channel(1.7, 0.5, 2.3, 2.0)));
-    }
-  }
-  for (int j = 0; j < nv; ++j) {
-    for (int i = 0; i < nu; ++i) {
-      const int a = base + j * (nu + 1) + i, b = a + 1, c = a + nu + 1, d = c + 1;
-      mesh->faces.emplace_back(a, b, d);
-      mesh->faces.emplace_back(a, d, c);
-    }
-  }
-}
-
 // Floor and four walls of a roofless room (x in [-5, 5], y in [-4, 4], z in [0, 3]) with
 // a box in the middle; optionally a sky plane 1e30 above.
 TriangleMesh MakeWorld(bool far_backdrop) {
   TriangleMesh mesh;
   const Eigen::Vector3d ex(10, 0, 0), ey(0, 8, 0), ez(0, 0, 3);
-  AddQuadGrid(&mesh, {-5, -4, 0}, ex, ey, 40, 32);
-  AddQuadGrid(&mesh, {-5, -4, 0}, ex, ez, 40, 12);
-  AddQuadGrid(&mesh, {-5, 4, 0}, ex, ez, 40, 12);
-  AddQuadGrid(&mesh, {-5, -4, 0}, ey, ez, 32, 12);
-  AddQuadGrid(&mesh, {5, -4, 0}, ey, ez, 32, 12);
+  AddColouredQuadGrid(&mesh, {-5, -4, 0}, ex, ey, 40, 32);
+  AddColouredQuadGrid(&mesh, {-5, -4, 0}, ex, ez, 40, 12);
+  AddColouredQuadGrid(&mesh, {-5, 4, 0}, ex, ez, 40, 12);
+  AddColouredQuadGrid(&mesh, {-5, -4, 0}, ey, ez, 32, 12);
+  AddColouredQuadGrid(&mesh, {5, -4, 0}, ey, ez, 32, 12);
   const Eigen::Vector3d bx(1.4, 0, 0), by(0, 1.0, 0), bz(0, 0, 1.2);
   const Eigen::Vector3d lo(-0.7, -0.5, 0);
-  AddQuadGrid(&mesh, lo, bx, by, 6, 4);
-  AddQuadGrid(&mesh, lo + bz, bx, by, 6, 4);
-  AddQuadGrid(&mesh, lo, bx, bz, 6, 5);
-  AddQuadGrid(&mesh, lo + by, bx, bz, 6, 5);
-  AddQuadGrid(&mesh, lo, by, bz, 4, 5);
-  AddQuadGrid(&mesh, lo + bx, by, bz, 4, 5);
+  AddColouredQuadGrid(&mesh, lo, bx, by, 6, 4);
+  AddColouredQuadGrid(&mesh, lo + bz, bx, by, 6, 4);
+  AddColouredQuadGrid(&mesh, lo, bx, bz, 6, 5);
+  AddColouredQuadGrid(&mesh, lo + by, bx, bz, 6, 5);
+  AddColouredQuadGrid(&mesh, lo, by, bz, 4, 5);
+  AddColouredQuadGrid(&mesh, lo + bx, by, bz, 4, 5);
   if (far_backdrop) {
-    AddQuadGrid(&mesh, {-1e31, -1e31, 1e30}, {2e31, 0, 0}, {0, 2e31, 0}, 4, 4);
+    AddColouredQuadGrid(&mesh, {-1e31, -1e31, 1e30}, {2e31, 0, 0}, {0, 2e31, 0}, 4, 4);
   }
   return mesh;
 }
