@@ -17,12 +17,6 @@ namespace fvs {
 
 namespace {
 
-std::string FrameName(int i) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "frame_%05d", i);
-  return buffer;
-}
-
 bool Finite(double v) { return std::isfinite(v); }
 
 // Output size from the options and the first keyframe.

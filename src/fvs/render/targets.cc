@@ -20,11 +20,6 @@ namespace fvs {
 
 namespace {
 
-std::string FrameName(int i) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "frame_%05d", i);
-  return buffer;
-}
 
 bool ParseDoubles(const std::vector<std::string>& tokens, size_t first, size_t count,
                   double* out) {
@@ -350,6 +345,12 @@ PinholeCamera ResizeTarget(const PinholeCamera& camera, int width, int height,
     return camera;
   }
   return camera.Resized(static_cast<int>(sw), static_cast<int>(sh));
+}
+
+std::string FrameName(int index) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "frame_%05d", index);
+  return buffer;
 }
 
 }  // namespace fvs

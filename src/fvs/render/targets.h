@@ -39,6 +39,9 @@ std::vector<TargetCamera> OrbitTargets(const Scene& scene, int num_views);
 // linear centre and intrinsics; the last view closes the path.
 std::vector<TargetCamera> InterpolateTargets(const Scene& scene, int num_per_segment);
 
+// The file stem of the index-th frame of a generated path: frame_00000, frame_00001, ...
+std::string FrameName(int index);
+
 // Output size: width/height > 0 set it (one of them alone keeps the aspect ratio), then
 // scale multiplies. Throws fvs::Error for a non-positive result.
 PinholeCamera ResizeTarget(const PinholeCamera& camera, int width, int height,
