@@ -682,7 +682,7 @@ class Mesher {
       if (face.longest > max_side) continue;
       if (!spacing.empty()) {
         const double local =
-            std::min({spacing[face.v[0]], spacing[face.v[1]], spacing[face.v[2]]});
+            std::max({spacing[face.v[0]], spacing[face.v[1]], spacing[face.v[2]]});
         if (face.longest > options_.max_side_spacing_factor * local) {
           ++stats->num_spacing_filtered;
           continue;

@@ -78,10 +78,10 @@ struct DelaunayMeshingOptions {
   // triangles. 0 neighbours = keep every point, as COLMAP.
   int isolated_point_neighbors = 8;
   double isolated_point_factor = 6.0;
-  // Not in COLMAP: also drop faces whose longest side exceeds this factor x the smallest
+  // Not in COLMAP: also drop faces whose longest side exceeds this factor x the largest
   // local point spacing (mean distance to the 8 nearest points) at its vertices. Faces
-  // that bridge empty space between parts of the cloud fail it; faces in sparse regions
-  // do not, as their spacing is large too. 0 = off, as COLMAP.
+  // that bridge empty space between parts of the cloud fail it; faces in sparse regions,
+  // or joining a sparse region to a dense one, do not. 0 = off, as COLMAP.
   double max_side_spacing_factor = 10.0;
   // <= 0: DefaultNumThreads() (COLMAP uses -1 for "all").
   int num_threads = -1;
