@@ -34,6 +34,7 @@ int64_t GruParams(int64_t in, int64_t c) {
 
 struct Inputs {
   torch::Tensor images, grid, valid_depth, valid_warp;
+  torch::Tensor ulr;  // ULR log-weights, the prior of fvs_fast
 };
 
 // K sources of an odd size, a target of another odd size; about 70% of the warp valid.
@@ -45,6 +46,7 @@ Inputs MakeInputs(int k, int target_h, int target_w, int source_h = 37,
   in.grid = torch::rand({k, target_h, target_w, 2}) * 2.2 - 1.1;
   in.valid_depth = (torch::rand({1, 1, target_h, target_w}) > 0.2).to(torch::kFloat);
   in.valid_warp = (torch::rand({k, 1, target_h, target_w}) > 0.3).to(torch::kFloat);
+  in.ulr = torch::log(torch::rand({k, 1, target_h, target_w}).clamp_min(1e-4));
   return in;
 }
 
@@ -159,7 +161,7 @@ TEST(FvsNetTest, EveryVariantGivesFiniteImagesOfTheTargetSize) {
     for (const Inputs* x : {&in, &odd}) {
       const int64_t k = x->images.size(0), h = x->grid.size(1), w = x->grid.size(2);
       const BlendOutput out =
-          net->Forward(x->images, x->grid, x->valid_depth, x->valid_warp);
+          net->Forward(x->images, x->grid, x->valid_depth, x->valid_warp, x->ulr);
       EXPECT_EQ(out.rgb.sizes().vec(), std::vector<int64_t>({1, 3, h, w}));
       EXPECT_TRUE(torch::isfinite(out.rgb).all().item<bool>());
       EXPECT_LE(out.rgb.abs().max().item<float>(), 1.0f);
@@ -188,14 +190,16 @@ TEST(FvsNetTest, BadShapesThrow) {
                Error);
 }
 
-TEST(FvsNetTest, RgbSkipStartsAsTheMeanOfTheSourcesThatSeeAPixel) {
+TEST(FvsNetTest, RgbSkipStartsAsThePriorBlendOfTheWarpedSources) {
   // fvs_fast untrained: zero heads, so each source contributes its own warped colour with
-  // confidence mask_prior * (valid_warp - 1).
+  // confidence ulr_prior * (ULR log-weight) + mask_prior * (valid_warp - 1): the ULR
+  // blend.
   torch::manual_seed(3);
   FvsNet net(ModelConfig::ForVariant("fvs_fast"));
   ASSERT_TRUE(net->config().rgb_skip);
-  const double prior = net->config().mask_prior;
-  ASSERT_GT(prior, 0);
+  const double mask_prior = net->config().mask_prior;
+  const double ulr_prior = net->config().ulr_prior;
+  ASSERT_GT(ulr_prior, 0);
   net->eval();
   torch::NoGradGuard no_grad;
   const Inputs in = MakeInputs(3, 16, 24);
@@ -203,18 +207,30 @@ TEST(FvsNetTest, RgbSkipStartsAsTheMeanOfTheSourcesThatSeeAPixel) {
   EXPECT_TRUE(
       torch::equal(encoded.narrow(1, net->config().feature_channels, 3), in.images));
   const torch::Tensor warped_rgb = WarpFeatures(in.images, in.grid);
-  const torch::Tensor w = torch::exp(prior * (in.valid_warp - 1));
+  const torch::Tensor w =
+      torch::exp(mask_prior * (in.valid_warp - 1) + ulr_prior * in.ulr);
   const torch::Tensor expected =
       ((w * warped_rgb).sum(0, true) / w.sum(0, true)).clamp(-1, 1);
-  const BlendOutput out = net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp);
+  const BlendOutput out =
+      net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp, in.ulr);
   EXPECT_LT((out.rgb - expected).abs().max().item<float>(), 1e-5f);
   EXPECT_LT((out.per_source_rgb - warped_rgb).abs().max().item<float>(), 1e-6f);
+  // Without its prior the blend refuses to run rather than silently blend uniformly.
+  EXPECT_THROW(net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp), Error);
+  EXPECT_THROW(net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp,
+                            in.ulr.narrow(0, 0, 2)),
+               Error);
   // The option is refused where it has no per-source colours to correct.
   EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_single","rgb_skip":true})"),
                Error);
   EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_nomasks","mask_prior":2})"),
                Error);
   EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_fast","mask_prior":-1})"), Error);
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_fast","ulr_prior":-1})"), Error);
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_nomasks","ulr_prior":1})"),
+               Error);
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_fast","ulr_num_blend":0})"),
+               Error);
 }
 
 TEST(SoftmaxWeightsTest, FiniteAndNormalisedAtExtremes) {
@@ -277,7 +293,7 @@ TEST(FvsNetTest, HugeEqualConfidencesInTheNetworkStayFinite) {
     }
     const Inputs in = MakeInputs(3, 16, 24);
     const BlendOutput out =
-        net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp);
+        net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp, in.ulr);
     EXPECT_TRUE(torch::isfinite(out.rgb).all().item<bool>());
     EXPECT_LT((out.weights - 1.0 / 3).abs().max().item<float>(), 1e-6f);
     // Equal weights: the blend is the mean of the per-source colours (before the clamp).
@@ -296,18 +312,20 @@ TEST(FvsNetTest, SingleSourceAndDeterminism) {
   torch::NoGradGuard no_grad;
   const Inputs one = MakeInputs(1, 24, 32);
   const BlendOutput a =
-      net->Forward(one.images, one.grid, one.valid_depth, one.valid_warp);
+      net->Forward(one.images, one.grid, one.valid_depth, one.valid_warp, one.ulr);
   EXPECT_TRUE(torch::equal(a.weights, torch::ones_like(a.weights)));
   EXPECT_TRUE(torch::allclose(a.rgb, a.per_source_rgb.clamp(-1, 1)));
   const BlendOutput b =
-      net->Forward(one.images, one.grid, one.valid_depth, one.valid_warp);
+      net->Forward(one.images, one.grid, one.valid_depth, one.valid_warp, one.ulr);
   EXPECT_TRUE(torch::equal(a.rgb, b.rgb));
 
   const Inputs three = MakeInputs(3, 24, 32);
-  const torch::Tensor c =
-      net->Forward(three.images, three.grid, three.valid_depth, three.valid_warp).rgb;
-  const torch::Tensor d =
-      net->Forward(three.images, three.grid, three.valid_depth, three.valid_warp).rgb;
+  const torch::Tensor c = net->Forward(three.images, three.grid, three.valid_depth,
+                                       three.valid_warp, three.ulr)
+                              .rgb;
+  const torch::Tensor d = net->Forward(three.images, three.grid, three.valid_depth,
+                                       three.valid_warp, three.ulr)
+                              .rgb;
   EXPECT_TRUE(torch::equal(c, d));
 }
 
@@ -321,7 +339,7 @@ TEST(FvsNetTest, RecurrenceCarriesAcrossSources) {
     net->eval();
     torch::NoGradGuard no_grad;
     const torch::Tensor warped = WarpFeatures(net->Encode(in.images), in.grid);
-    const BlendOutput both = net->Blend(warped, in.valid_depth, in.valid_warp);
+    const BlendOutput both = net->Blend(warped, in.valid_depth, in.valid_warp, in.ulr);
     const BlendOutput second =
         net->Blend(warped.narrow(0, 1, 1), in.valid_depth, in.valid_warp.narrow(0, 1, 1));
     const float diff = (both.per_source_rgb.narrow(0, 1, 1) - second.per_source_rgb)
@@ -359,7 +377,7 @@ TEST(FvsNetTest, TrainingGivesFiniteGradientsEverywhere) {
     net->train();
     const Inputs in = MakeInputs(2, 16, 24, 20, 28);
     const BlendOutput out =
-        net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp);
+        net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp, in.ulr);
     (out.rgb - 0.5).abs().mean().backward();
     for (const auto& p : net->named_parameters()) {
       ASSERT_TRUE(p.value().grad().defined()) << p.key();
@@ -390,6 +408,10 @@ TEST(WarpFeaturesTest, IdentityGridReproducesAndOutsideIsZero) {
   const torch::Tensor expected =
       0.5 * (features.narrow(3, 0, 8) + features.narrow(3, 1, 8));
   EXPECT_LT((half.narrow(3, 0, 8) - expected).abs().max().item<float>(), 1e-5f);
+  // The last column now samples the right edge of the image: the border pixel itself,
+  // not half of it (no darkened photo edges).
+  EXPECT_LT((half.narrow(3, 8, 1) - features.narrow(3, 8, 1)).abs().max().item<float>(),
+            1e-5f);
 
   const float inf = std::numeric_limits<float>::infinity();
   const float nan = std::numeric_limits<float>::quiet_NaN();

@@ -7,6 +7,9 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "fvs/net/net.h"
 #include "fvs/render/method.h"
 #include "fvs/util/error.h"
@@ -66,7 +69,7 @@ TEST(FvsMethod, FiniteDeterministicAndCached) {
 TEST(FvsMethod, EveryVariantRendersFiniteImages) {
   testing::TempDir dir;
   const Scene scene = testing::MakeTestScene(4, 40, 32);
-  for (const std::string& variant :
+  for (const char* variant :
        {"fvs", "fvs_nogru", "fvs_nomasks", "fvs_noinfdepth", "fvs_single"}) {
     RenderOptions options;
     options.num_sources = 2;
@@ -75,6 +78,42 @@ TEST(FvsMethod, EveryVariantRendersFiniteImages) {
         CreateMethod(variant, options)->Render(scene, HeldOutTarget(scene, 1));
     EXPECT_TRUE(testing::AllFinite(r.color)) << variant;
     EXPECT_EQ(r.color.width, 40) << variant;
+  }
+}
+
+// fvs_fast starts from the ULR blend (ModelConfig::ulr_prior, rgb_skip, zero heads): the
+// untrained network must render what the `ulr` method renders, wherever a source sees the
+// pixel. What remains are the borders of the photos (ulr clamps its bilinear samples,
+// grid_sample pads with zeros) and the prior's floor (kUlrWeightFloor).
+TEST(FvsMethod, UntrainedFastNetworkRendersTheUlrBlend) {
+  testing::TempDir dir;
+  const Scene scene = testing::MakeTestScene(6, 64, 48);
+  RenderOptions options;
+  options.num_sources = 4;
+  options.model_path = SaveRandomModel(dir.path(), "fvs_fast");
+  for (const int view : {1, 3}) {
+    SCOPED_TRACE(view);
+    const TargetView target = HeldOutTarget(scene, view);
+    const RenderResult net = CreateMethod("fvs", options)->Render(scene, target);
+    const RenderResult ulr = CreateMethod("ulr", options)->Render(scene, target);
+    ASSERT_EQ(net.color.data.size(), ulr.color.data.size());
+    double sum = 0, worst = 0;
+    int covered = 0, close = 0;
+    for (size_t i = 0; i < ulr.coverage.data.size(); ++i) {
+      if (ulr.coverage.data[i] <= 0) continue;
+      ++covered;
+      double diff = 0;
+      for (int c = 0; c < 3; ++c) {
+        diff = std::max<double>(
+            diff, std::abs(net.color.data[3 * i + c] - ulr.color.data[3 * i + c]));
+      }
+      sum += diff;
+      worst = std::max(worst, diff);
+      close += diff < 1.0 / 255;
+    }
+    ASSERT_GT(covered, 1000);
+    EXPECT_LT(sum / covered, 1e-3) << "worst " << worst;
+    EXPECT_GT(static_cast<double>(close) / covered, 0.99) << "worst " << worst;
   }
 }
 

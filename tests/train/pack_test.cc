@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -245,7 +246,7 @@ TEST_F(PackTest, TrainingWarpAgreesWithCpuWarpMaps) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> jitter(-0.3, 0.3);
   int64_t compared = 0, valid = 0, mask_mismatch = 0;
-  double max_grid_error = 0;
+  double max_grid_error = 0, max_prior_error = 0;
   for (int trial = 0; trial < 6; ++trial) {
     // Scene cameras are scene-centred.
     PinholeCamera target = scene_->ToSceneCamera(testing::ArcCamera(jitter(rng), 40, 30));
@@ -267,9 +268,37 @@ TEST_F(PackTest, TrainingWarpAgreesWithCpuWarpMaps) {
       ds.push_back(DepthTensor(source_depths[k]));
     }
     WarpSettings settings;
+    settings.ulr_log_weights = true;
     const TrainingWarp warp = ComputeTrainingWarp(
         CameraK(target), CameraR(target), CameraT(target), DepthTensor(target_depth),
         torch::stack(ks), torch::stack(rs), torch::stack(ts), torch::stack(ds), settings);
+    // The ULR prior against the renderer's per-point weights (net/ulr_weights.h) from
+    // the CPU warp's masks and the cameras in double.
+    UlrSources ulr;
+    ulr.target_focal = std::sqrt(target.fx * target.fy);
+    for (const PinholeCamera& src : sources) {
+      ulr.centers.push_back(target.WorldToCamera(src.Center()));
+      ulr.focals.push_back(std::sqrt(src.fx * src.fy));
+    }
+    std::vector<WarpMap> maps;
+    for (size_t k = 0; k < sources.size(); ++k) {
+      maps.push_back(ComputeWarpMap(target, target_depth, sources[k], source_depths[k]));
+    }
+    const torch::Tensor prior = warp.ulr_log_weights.contiguous();
+    ASSERT_EQ(prior.sizes().vec(), std::vector<int64_t>({3, 1, 30, 40}));
+    for (int i = 0; i < 30 * 40; ++i) {
+      bool sees[3];
+      double weights[3];
+      for (int k = 0; k < 3; ++k) sees[k] = maps[k].valid_warp.data[i] > 0;
+      const Eigen::Vector3d point = target.PixelToCamera(
+          i % 40 + 0.5, i / 40 + 0.5, EffectiveDepth(target_depth.data[i], 1e9));
+      UlrPointWeights(point, ulr, sees, UlrSettings(), weights);
+      for (int k = 0; k < 3; ++k) {
+        const double expected = std::log(std::max(weights[k], kUlrWeightFloor));
+        max_prior_error = std::max(
+            max_prior_error, std::abs(prior.data_ptr<float>()[k * 1200 + i] - expected));
+      }
+    }
     for (size_t k = 0; k < sources.size(); ++k) {
       const WarpMap map =
           ComputeWarpMap(target, target_depth, sources[k], source_depths[k]);
@@ -298,6 +327,7 @@ TEST_F(PackTest, TrainingWarpAgreesWithCpuWarpMaps) {
   EXPECT_GT(valid, compared / 4);  // the test sees real warps, not an empty mask
   EXPECT_EQ(mask_mismatch, 0);
   EXPECT_LT(max_grid_error, 1e-5);
+  EXPECT_LT(max_prior_error, 1e-4);
 }
 
 TEST_F(PackTest, NoInfDepthLeavesSkyInvalid) {

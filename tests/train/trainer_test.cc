@@ -31,7 +31,7 @@ const char kTinyNet[] =
 const char kTinyNetNoSkip[] =
     R"({"variant": "fvs_fast", "feature_channels": 8, "encoder_channels": [8, 16, 16],
         "encoder_convs": [1, 1, 1], "blend_channels": [8, 16, 16], "blend_convs_per_stage": 2,
-        "rgb_skip": false, "mask_prior": 0})";
+        "rgb_skip": false, "mask_prior": 0, "ulr_prior": 0})";
 
 class TrainerTest : public ::testing::Test {
  protected:
@@ -72,16 +72,18 @@ TEST_F(TrainerTest, LossDecreasesOnAFixedSample) {
   torch::set_num_threads(1);
   torch::manual_seed(0);
   const PackedScene scene = LoadPackedScene(dir_->path() + "/scene_a");
-  const TrainingSample s = MakeSample(scene, 2, SelectTrainingSources(scene, 2, 2), 16, 8,
-                                      32, 32, WarpSettings());
+  WarpSettings warp;
+  warp.ulr_log_weights = true;  // the prior of fvs_fast
+  const TrainingSample s =
+      MakeSample(scene, 2, SelectTrainingSources(scene, 2, 2), 16, 8, 32, 32, warp);
   TrainingLoss loss("", torch::kCPU);
   auto train = [&](const char* config, double* first, double* last) {
     FvsNet net(ModelConfig::FromJson(config));
     torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(3e-3));
     for (int i = 0; i < 30; ++i) {
       adam.zero_grad();
-      const BlendOutput out =
-          net->Forward(s.source_rgb, s.warp.grid, s.warp.valid_depth, s.warp.valid_warp);
+      const BlendOutput out = net->Forward(s.source_rgb, s.warp.grid, s.warp.valid_depth,
+                                           s.warp.valid_warp, s.warp.ulr_log_weights);
       LossValue l = loss((out.rgb + 1) * 0.5, s.target_rgb);
       l.total.backward();
       adam.step();
@@ -144,7 +146,8 @@ TEST_F(TrainerTest, ResumedRunIsBitIdenticalToAnUninterruptedOne) {
   EXPECT_GT(changed, 0);
   // Validation wrote its rows (two passes: step 2 and the end).
   const std::string csv = ReadFileToString(dir_->path() + "/straight/validation.csv");
-  EXPECT_NE(csv.find("step,scene,views,psnr,ssim,seconds_per_view"), std::string::npos);
+  EXPECT_NE(csv.find("step,scene,views,psnr,ssim,seconds_per_view,ulr_psnr,ulr_ssim\n"),
+            std::string::npos);
   EXPECT_NE(csv.find("\n2,all,2,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("\n4,all,2,"), std::string::npos) << csv;
   const std::string card = ReadFileToString(dir_->path() + "/straight/model.json");

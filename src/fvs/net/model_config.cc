@@ -59,10 +59,10 @@ ModelConfig ModelConfig::ForVariant(const std::string& name) {
     c.blend_channels = {16, 32, 64, 128};
     c.blend_convs_per_stage = 2;
     c.depthwise_separable = false;
-    // Trains on a CPU in hours rather than weeks: it starts as the mean of the sources
-    // that see a pixel and learns confidences and corrections from there.
+    // Trains on a CPU in hours rather than weeks: it starts as the ULR blend of the
+    // sources that see a pixel and learns confidences and corrections from there.
     c.rgb_skip = true;
-    c.mask_prior = 4.0;
+    c.ulr_prior = 1.0;
   } else {
     throw Error(kSubject, "unknown network variant '" + name +
                               "' (known: " + JoinNames(KnownVariants()) + ")");
@@ -85,6 +85,9 @@ std::string ModelConfig::ToJson() const {
   j["depthwise_separable"] = depthwise_separable;
   j["rgb_skip"] = rgb_skip;
   j["mask_prior"] = mask_prior;
+  j["ulr_prior"] = ulr_prior;
+  j["ulr_num_blend"] = ulr_num_blend;
+  j["ulr_resolution_weight"] = ulr_resolution_weight;
   return j.dump();
 }
 
@@ -112,7 +115,10 @@ ModelConfig ModelConfig::FromJson(const std::string& text) {
                                         "blend_convs_per_stage",
                                         "depthwise_separable",
                                         "rgb_skip",
-                                        "mask_prior"};
+                                        "mask_prior",
+                                        "ulr_prior",
+                                        "ulr_num_blend",
+                                        "ulr_resolution_weight"};
   for (auto it = j.begin(); it != j.end(); ++it) {
     bool known = false;
     for (const char* field : kFields) known = known || it.key() == field;
@@ -131,6 +137,9 @@ ModelConfig ModelConfig::FromJson(const std::string& text) {
   Read(j, "depthwise_separable", &c.depthwise_separable);
   Read(j, "rgb_skip", &c.rgb_skip);
   Read(j, "mask_prior", &c.mask_prior);
+  Read(j, "ulr_prior", &c.ulr_prior);
+  Read(j, "ulr_num_blend", &c.ulr_num_blend);
+  Read(j, "ulr_resolution_weight", &c.ulr_resolution_weight);
   c.Check();
   return c;
 }
@@ -164,6 +173,14 @@ void ModelConfig::Check() const {
           "mask_prior must be in [0, 30]");
   require(mask_prior == 0 || (use_masks && soft_argmax),
           "mask_prior needs use_masks and soft_argmax");
+  require(std::isfinite(ulr_prior) && ulr_prior >= 0 && ulr_prior <= 10,
+          "ulr_prior must be in [0, 10]");
+  require(ulr_prior == 0 || (use_masks && soft_argmax),
+          "ulr_prior needs use_masks and soft_argmax");
+  require(ulr_num_blend >= 1 && ulr_num_blend <= 64, "ulr_num_blend must be in [1, 64]");
+  require(std::isfinite(ulr_resolution_weight) && ulr_resolution_weight >= 0 &&
+              ulr_resolution_weight <= 100,
+          "ulr_resolution_weight must be in [0, 100]");
 }
 
 }  // namespace fvs

@@ -43,6 +43,14 @@ struct ModelConfig {
   // that does not see a pixel starts with e^-mask_prior of the weight (needs use_masks
   // and soft_argmax). 0 = the paper's purely learnt confidences.
   double mask_prior = 0;
+  // > 0: ulr_prior * log(ULR weight) (net/ulr_weights.h, floored at kUlrWeightFloor) is
+  // added to each source's confidence. With rgb_skip and the zero-initialised heads the
+  // untrained net renders exactly what the `ulr` method renders, and training learns
+  // corrections to it (not in the paper; the CPU variant). The ULR settings are part of
+  // the model so that a set of weights always blends from the prior it was trained with.
+  double ulr_prior = 0;
+  int ulr_num_blend = 4;
+  double ulr_resolution_weight = 0.2;
 
   // Throws fvs::Error for an unknown name, listing the known ones.
   static ModelConfig ForVariant(const std::string& name);

@@ -34,7 +34,8 @@ ModelInfo DescribeModel(FvsNet& net, int width, int height, bool time_forward) {
   info.encode_seconds = timer.Seconds();
   timer.Restart();
   const torch::Tensor warped = WarpFeatures(features, IdentityGrid(1, height, width));
-  const BlendOutput out = net->Blend(warped, valid_depth, valid_warp);
+  const torch::Tensor ulr_log_weights = torch::zeros({1, 1, height, width});
+  const BlendOutput out = net->Blend(warped, valid_depth, valid_warp, ulr_log_weights);
   info.blend_seconds = timer.Seconds();
   Require(torch::isfinite(out.rgb).all().item<bool>(), "model info",
           "the forward pass produced NaN or Inf");
@@ -46,13 +47,14 @@ std::string FormatModelInfo(const ModelInfo& info) {
   char line[512];
   std::string s;
   const ModelConfig& c = info.config;
-  std::snprintf(line, sizeof(line),
-                "%s: features %d, masks %s, gru %s, soft-argmax %s, inf-depth %s, "
-                "separable %s, rgb skip %s, mask prior %g\n",
-                c.variant.c_str(), c.feature_channels, c.use_masks ? "yes" : "no",
-                c.use_gru ? "yes" : "no", c.soft_argmax ? "yes" : "no",
-                c.inf_depth ? "yes" : "no", c.depthwise_separable ? "yes" : "no",
-                c.rgb_skip ? "yes" : "no", c.mask_prior);
+  std::snprintf(
+      line, sizeof(line),
+      "%s: features %d, masks %s, gru %s, soft-argmax %s, inf-depth %s, "
+      "separable %s, rgb skip %s, mask prior %g, ulr prior %g (k %d, resolution %g)\n",
+      c.variant.c_str(), c.feature_channels, c.use_masks ? "yes" : "no",
+      c.use_gru ? "yes" : "no", c.soft_argmax ? "yes" : "no", c.inf_depth ? "yes" : "no",
+      c.depthwise_separable ? "yes" : "no", c.rgb_skip ? "yes" : "no", c.mask_prior,
+      c.ulr_prior, c.ulr_num_blend, c.ulr_resolution_weight);
   s += line;
   std::snprintf(
       line, sizeof(line), "  parameters: encoder %lld, blender %lld, total %lld\n",

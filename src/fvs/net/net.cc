@@ -249,7 +249,8 @@ torch::Tensor FvsNetImpl::BlendPass(const torch::Tensor& input,
 
 BlendOutput FvsNetImpl::Blend(const torch::Tensor& warped,
                               const torch::Tensor& valid_depth,
-                              const torch::Tensor& valid_warp) {
+                              const torch::Tensor& valid_warp,
+                              const torch::Tensor& ulr_log_weights) {
   Require(warped.dim() == 4 && warped.size(0) > 0 &&
               warped.size(1) == config_.EncodedChannels(),
           kSubject,
@@ -270,6 +271,15 @@ BlendOutput FvsNetImpl::Blend(const torch::Tensor& warped,
             "Blend expects valid_warp [" + std::to_string(k) + ",1," +
                 std::to_string(height) + "," + std::to_string(width) + "], got " +
                 Shape(valid_warp));
+  }
+  if (config_.ulr_prior > 0) {
+    Require(ulr_log_weights.defined() && ulr_log_weights.dim() == 4 &&
+                ulr_log_weights.size(0) == k && ulr_log_weights.size(1) == 1 &&
+                ulr_log_weights.size(2) == height && ulr_log_weights.size(3) == width,
+            kSubject,
+            "Blend expects ULR log-weights [" + std::to_string(k) + ",1," +
+                std::to_string(height) + "," + std::to_string(width) + "], got " +
+                Shape(ulr_log_weights));
   }
   // The input of sources [first, first + count): features + masks, padded. Built per
   // source in the recurrent case so that the full [K,66,H,W] never exists beside
@@ -305,6 +315,11 @@ BlendOutput FvsNetImpl::Blend(const torch::Tensor& warped,
             config_.mask_prior *
                 (valid_warp.narrow(0, first, count).to(confidence.options()) - 1);
       }
+      if (config_.ulr_prior > 0) {
+        confidence = confidence +
+                     config_.ulr_prior *
+                         ulr_log_weights.narrow(0, first, count).to(confidence.options());
+      }
       rgbs.push_back(rgb);
       confidences.push_back(confidence);
     } else {
@@ -335,8 +350,10 @@ BlendOutput FvsNetImpl::Blend(const torch::Tensor& warped,
 
 BlendOutput FvsNetImpl::Forward(const torch::Tensor& images, const torch::Tensor& grid,
                                 const torch::Tensor& valid_depth,
-                                const torch::Tensor& valid_warp) {
-  return Blend(WarpFeatures(Encode(images), grid), valid_depth, valid_warp);
+                                const torch::Tensor& valid_warp,
+                                const torch::Tensor& ulr_log_weights) {
+  return Blend(WarpFeatures(Encode(images), grid), valid_depth, valid_warp,
+               ulr_log_weights);
 }
 
 int64_t FvsNetImpl::EncoderParameterCount() const {
@@ -379,11 +396,19 @@ torch::Tensor WarpFeatures(const torch::Tensor& features, const torch::Tensor& g
   // sample nothing rather than poison the features: send them outside [-1,1].
   const torch::Tensor safe_grid =
       torch::nan_to_num(grid.to(features.options()), 2.0, 2.0, -2.0).clamp(-2.0, 2.0);
+  // Inside the image the outer half pixel replicates the border pixel (as the `ulr`
+  // method's colour samples: zero padding would darken every photo's edge by up to
+  // half); outside it, nothing. (The slack absorbs float rounding of an exact edge.)
+  const torch::Tensor inside = (safe_grid.abs() <= 1.0 + 1e-6)
+                                   .all(3, /*keepdim=*/false)
+                                   .unsqueeze(1)
+                                   .to(features.dtype());
   return F::grid_sample(features, safe_grid,
                         F::GridSampleFuncOptions()
                             .mode(torch::kBilinear)
-                            .padding_mode(torch::kZeros)
-                            .align_corners(false));
+                            .padding_mode(torch::kBorder)
+                            .align_corners(false)) *
+         inside;
 }
 
 torch::Tensor IdentityGrid(int64_t count, int64_t height, int64_t width) {

@@ -70,12 +70,15 @@ class FvsNetImpl : public torch::nn::Module {
   // [K,3,H,W] in [-1,1], any H, W -> [K,config.EncodedChannels(),H,W] (the features,
   // then the image itself with rgb_skip).
   torch::Tensor Encode(const torch::Tensor& images);
-  // warped [K,C,Ht,Wt], valid_depth [1,1,Ht,Wt], valid_warp [K,1,Ht,Wt] (float 0/1).
+  // warped [K,C,Ht,Wt], valid_depth [1,1,Ht,Wt], valid_warp [K,1,Ht,Wt] (float 0/1),
+  // ulr_log_weights [K,1,Ht,Wt] (UlrLogWeights; needed when config.ulr_prior > 0).
   BlendOutput Blend(const torch::Tensor& warped, const torch::Tensor& valid_depth,
-                    const torch::Tensor& valid_warp);
+                    const torch::Tensor& valid_warp,
+                    const torch::Tensor& ulr_log_weights = {});
   // Training: Encode + WarpFeatures + Blend. grid [K,Ht,Wt,2] as in WarpFeatures.
   BlendOutput Forward(const torch::Tensor& images, const torch::Tensor& grid,
-                      const torch::Tensor& valid_depth, const torch::Tensor& valid_warp);
+                      const torch::Tensor& valid_depth, const torch::Tensor& valid_warp,
+                      const torch::Tensor& ulr_log_weights = {});
 
   int64_t EncoderParameterCount() const;
   int64_t BlenderParameterCount() const;
@@ -103,9 +106,10 @@ class FvsNetImpl : public torch::nn::Module {
 };
 TORCH_MODULE(FvsNet);
 
-// Bilinear sampling with zero padding (grid_sample, align_corners = false): grid
-// [K,Ht,Wt,2] holds source positions in [-1,1] (x then y; -1 = left edge of the first
-// pixel). Non-finite grid entries sample nothing (zeros).
+// Bilinear sampling (grid_sample, align_corners = false): grid [K,Ht,Wt,2] holds source
+// positions in [-1,1] (x then y; -1 = left edge of the first pixel). Within the image the
+// outer half pixel replicates the border pixel; positions outside [-1,1] and non-finite
+// ones sample nothing (zeros).
 torch::Tensor WarpFeatures(const torch::Tensor& features, const torch::Tensor& grid);
 
 // The grid that maps every target pixel onto itself ([K,H,W,2]).

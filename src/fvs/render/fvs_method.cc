@@ -7,7 +7,9 @@
 
 #include "fvs/net/net.h"
 #include "fvs/render/prepare.h"
+#include "fvs/render/ulr.h"
 #include "fvs/scene/scene.h"
+#include "fvs/scene/warp.h"
 #include "fvs/util/error.h"
 #include "fvs/util/progress.h"
 
@@ -31,6 +33,38 @@ Image ToImage(const torch::Tensor& chw) {
   std::memcpy(image.data.data(), hwc.data_ptr<float>(),
               image.data.size() * sizeof(float));
   return image;
+}
+
+// The prior of ModelConfig::ulr_prior: ULR log-weights [K,1,H,W] of the prepared
+// sources, from the same surface points the `ulr` method blends at (`depth`: the
+// target's, as rendered for it).
+torch::Tensor UlrLogWeightTensor(const Scene& scene, const TargetView& target,
+                                 const PreparedTarget& prepared, const Image& depth,
+                                 const torch::Tensor& warp_mask,
+                                 const ModelConfig& config, int num_threads) {
+  const PinholeCamera& cam = target.camera;
+  const int w = cam.width, h = cam.height;
+  const int64_t num_pixels = static_cast<int64_t>(w) * h;
+  const WarpOptions warp_defaults;
+  std::vector<double> points(3 * num_pixels);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int64_t i = static_cast<int64_t>(y) * w + x;
+      const double d = EffectiveDepth(depth.data[i], warp_defaults.invalid_depth);
+      const Eigen::Vector3d p = cam.PixelToCamera(x + 0.5, y + 0.5, d);
+      for (int c = 0; c < 3; ++c) points[3 * i + c] = p[c];
+    }
+  }
+  const int64_t k = warp_mask.size(0);
+  const torch::Tensor sees = warp_mask.reshape({k, num_pixels}).contiguous();
+  torch::Tensor log_weights = torch::empty({k, num_pixels}, torch::kFloat32);
+  UlrSettings settings;
+  settings.num_blend = config.ulr_num_blend;
+  settings.resolution_weight = config.ulr_resolution_weight;
+  UlrLogWeights(points.data(), num_pixels, MakeUlrSources(scene, target, prepared),
+                sees.data_ptr<float>(), settings, log_weights.data_ptr<float>(),
+                num_threads);
+  return log_weights.reshape({k, 1, h, w});
 }
 
 class FvsMethod : public Method {
@@ -76,7 +110,13 @@ class FvsMethod : public Method {
       // Without the "far away" convention a pixel with no surface has no valid warp.
       warp_mask = warp_mask * valid_depth;
     }
-    const BlendOutput out = net_->Blend(torch::cat(warped, 0), valid_depth, warp_mask);
+    torch::Tensor ulr_log_weights;
+    if (config_.ulr_prior > 0) {
+      ulr_log_weights = UlrLogWeightTensor(scene, target, prepared, result.depth,
+                                           warp_mask, config_, options_.num_threads);
+    }
+    const BlendOutput out =
+        net_->Blend(torch::cat(warped, 0), valid_depth, warp_mask, ulr_log_weights);
     // [-1,1] -> [0,1]; the net clamps and removes NaN at inference.
     result.color = ToImage((out.rgb + 1.0) * 0.5);
     const torch::Tensor covered = (warp_mask.sum(0, true) > 0).to(torch::kFloat32);

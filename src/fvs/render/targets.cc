@@ -20,7 +20,6 @@ namespace fvs {
 
 namespace {
 
-
 bool ParseDoubles(const std::vector<std::string>& tokens, size_t first, size_t count,
                   double* out) {
   if (tokens.size() < first + count) return false;

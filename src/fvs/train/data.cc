@@ -196,6 +196,25 @@ TrainingWarp ComputeTrainingWarp(
                  .to(torch::kFloat);
   out.valid_depth = surface.to(torch::kFloat).reshape({1, 1, h, w});
   out.valid_warp = valid.to(torch::kFloat).reshape({k, 1, h, w});
+  if (settings.ulr_log_weights) {
+    // Source centres in the target frame: -R_rel^T t_rel.
+    const torch::Tensor centers =
+        -torch::matmul(R_rel.transpose(1, 2), t_rel.unsqueeze(-1)).squeeze(-1);
+    UlrSources ulr;
+    ulr.target_focal = std::sqrt(fx * fy);
+    const torch::Tensor sf = torch::sqrt(sfx * sfy).reshape({k}).contiguous();
+    for (int64_t s = 0; s < k; ++s) {
+      ulr.centers.emplace_back(centers[s][0].item<double>(), centers[s][1].item<double>(),
+                               centers[s][2].item<double>());
+      ulr.focals.push_back(sf[s].item<double>());
+    }
+    const torch::Tensor pts = points.reshape({h * w, 3}).contiguous();
+    const torch::Tensor sees = out.valid_warp.reshape({k, h * w}).contiguous();
+    torch::Tensor log_weights = torch::empty({k, h * w}, torch::kFloat);
+    UlrLogWeights(pts.data_ptr<double>(), h * w, ulr, sees.data_ptr<float>(),
+                  settings.ulr, log_weights.data_ptr<float>(), /*num_threads=*/1);
+    out.ulr_log_weights = log_weights.reshape({k, 1, h, w});
+  }
   return out;
 }
 

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "fvs/net/ulr_weights.h"
+
 namespace fvs {
 
 struct PackedScene {
@@ -39,12 +41,18 @@ struct WarpSettings {
   double occlusion_tolerance = 0.01;  // |z - D_source| <= tol * z
   bool inf_depth = true;              // no-surface target pixels at invalid_depth
   double invalid_depth = 1e9;
+  // Also compute the ULR log-weights (the prior of ModelConfig::ulr_prior) with these
+  // settings.
+  bool ulr_log_weights = false;
+  UlrSettings ulr;
 };
 
 struct TrainingWarp {
   torch::Tensor grid;         // float [K,h,w,2], grid_sample (align_corners = false)
   torch::Tensor valid_depth;  // float [1,1,h,w]
   torch::Tensor valid_warp;   // float [K,1,h,w]
+  // float [K,1,h,w], UlrLogWeights (only with WarpSettings::ulr_log_weights).
+  torch::Tensor ulr_log_weights;
 };
 
 // target_K/R/t: double [3,3], [3,3], [3]; target_depth float [h,w] (its camera's image

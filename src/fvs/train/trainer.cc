@@ -75,11 +75,18 @@ std::string UtcNow() {
 }
 
 struct DeviceSample {
-  torch::Tensor target, sources, grid, valid_depth, valid_warp;
+  torch::Tensor target, sources, grid, valid_depth, valid_warp, ulr_log_weights;
 };
 DeviceSample ToDevice(const TrainingSample& s, const torch::Device& device) {
-  return {s.target_rgb.to(device), s.source_rgb.to(device), s.warp.grid.to(device),
-          s.warp.valid_depth.to(device), s.warp.valid_warp.to(device)};
+  auto to = [&](const torch::Tensor& t) { return t.defined() ? t.to(device) : t; };
+  return {to(s.target_rgb),       to(s.source_rgb),      to(s.warp.grid),
+          to(s.warp.valid_depth), to(s.warp.valid_warp), to(s.warp.ulr_log_weights)};
+}
+
+void SetUlrPrior(const ModelConfig& config, WarpSettings* warp) {
+  warp->ulr_log_weights = config.ulr_prior > 0;
+  warp->ulr.num_blend = config.ulr_num_blend;
+  warp->ulr.resolution_weight = config.ulr_resolution_weight;
 }
 
 }  // namespace
@@ -122,6 +129,7 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
   sampler.source_margin = options_.source_margin;
   sampler.warp.occlusion_tolerance = options_.occlusion_tolerance;
   sampler.warp.inf_depth = config_.inf_depth;
+  SetUlrPrior(config_, &sampler.warp);
   // A seed of its own stream: the sampler must not share draws with LibTorch.
   sampler_ = std::make_unique<TrainingSampler>(
       &train_scenes_, sampler,
@@ -137,7 +145,8 @@ LossValue Trainer::Step() {
   const int b = options_.batch_size;
   for (int i = 0; i < b; ++i) {
     const DeviceSample s = ToDevice(sampler_->Next(), device_);
-    const BlendOutput out = net_->Forward(s.sources, s.grid, s.valid_depth, s.valid_warp);
+    const BlendOutput out =
+        net_->Forward(s.sources, s.grid, s.valid_depth, s.valid_warp, s.ulr_log_weights);
     const torch::Tensor prediction01 = (out.rgb + 1.0) * 0.5;
     LossValue loss = (*loss_)(prediction01, s.target);
     Require(std::isfinite(loss.l1) && std::isfinite(loss.second), "view_synthesis_train",
@@ -162,6 +171,8 @@ ValidationResult Trainer::Validate() {
   WarpSettings warp;
   warp.occlusion_tolerance = options_.occlusion_tolerance;
   warp.inf_depth = config_.inf_depth;
+  SetUlrPrior(config_, &warp);
+  warp.ulr_log_weights = true;  // for the baseline, whatever the network
   int total_views = 0;
   for (const PackedScene& scene : val_scenes_) {
     ValidationResult::Scene r;
@@ -177,23 +188,39 @@ ValidationResult Trainer::Validate() {
           MakeSample(scene, target, sources, 0, 0, scene.width(), scene.height(), warp);
       Timer timer;
       const DeviceSample s = ToDevice(sample, device_);
-      const BlendOutput out =
-          net_->Forward(s.sources, s.grid, s.valid_depth, s.valid_warp);
+      const BlendOutput out = net_->Forward(s.sources, s.grid, s.valid_depth,
+                                            s.valid_warp, s.ulr_log_weights);
       const torch::Tensor prediction = ((out.rgb + 1.0) * 0.5).clamp(0.0, 1.0);
       if (device_.is_cuda()) torch::cuda::synchronize();
       seconds += timer.Seconds();
-      const double mse = (prediction - s.target).pow(2).mean().item<double>();
-      r.psnr += 10.0 * std::log10(1.0 / std::max(mse, 1e-10));
+      auto psnr = [&](const torch::Tensor& image) {
+        const double mse = (image - s.target).pow(2).mean().item<double>();
+        return 10.0 * std::log10(1.0 / std::max(mse, 1e-10));
+      };
+      r.psnr += psnr(prediction);
       r.ssim += Ssim(prediction, s.target).item<double>();
+      const torch::Tensor seen = (s.valid_warp.sum(0, true) > 0).to(torch::kFloat);
+      const torch::Tensor ulr =
+          (((SoftmaxWeights(s.ulr_log_weights) * WarpFeatures(s.sources, s.grid))
+                .sum(0, true) +
+            1.0) *
+           0.5 * seen)
+              .clamp(0.0, 1.0);
+      r.ulr_psnr += psnr(ulr);
+      r.ulr_ssim += Ssim(ulr, s.target).item<double>();
       ++r.views;
     }
     if (r.views == 0) continue;
     result.psnr += r.psnr;
     result.ssim += r.ssim;
+    result.ulr_psnr += r.ulr_psnr;
+    result.ulr_ssim += r.ulr_ssim;
     result.seconds_per_view += seconds;
     total_views += r.views;
     r.psnr /= r.views;
     r.ssim /= r.views;
+    r.ulr_psnr /= r.views;
+    r.ulr_ssim /= r.views;
     r.seconds_per_view = seconds / r.views;
     result.scenes.push_back(r);
   }
@@ -201,6 +228,8 @@ ValidationResult Trainer::Validate() {
   if (total_views > 0) {
     result.psnr /= total_views;
     result.ssim /= total_views;
+    result.ulr_psnr /= total_views;
+    result.ulr_ssim /= total_views;
     result.seconds_per_view /= total_views;
   }
   // validation.csv: append atomically (the old rows and the new, then rename).
@@ -208,22 +237,32 @@ ValidationResult Trainer::Validate() {
   const std::string csv = options_.output_path + "/validation.csv";
   std::string text;
   if (std::filesystem::exists(csv)) text = ReadFileToString(csv);
-  if (text.empty()) text = "step,scene,views,psnr,ssim,seconds_per_view\n";
+  const std::string header =
+      "step,scene,views,psnr,ssim,seconds_per_view,ulr_psnr,ulr_ssim";
+  if (text.empty()) text = header + "\n";
+  // Files of older runs had no ULR columns: the header names the newest layout.
+  if (text.compare(0, header.size() + 1, header + "\n") != 0) {
+    text = header + text.substr(std::min(text.find('\n'), text.size()));
+  }
   std::ostringstream rows;
   rows << std::setprecision(6);
   for (const auto& r : result.scenes) {
     rows << step_ << "," << r.path << "," << r.views << "," << r.psnr << "," << r.ssim
-         << "," << r.seconds_per_view << "\n";
+         << "," << r.seconds_per_view << "," << r.ulr_psnr << "," << r.ulr_ssim << "\n";
   }
   rows << step_ << ",all," << total_views << "," << result.psnr << "," << result.ssim
-       << "," << result.seconds_per_view << "\n";
+       << "," << result.seconds_per_view << "," << result.ulr_psnr << ","
+       << result.ulr_ssim << "\n";
   text += rows.str();
   WriteFileAtomic(csv, [&](std::ostream& out) { out << text; });
   if (!options_.quiet) {
     std::cerr << "[train] validation at step " << step_ << ": PSNR " << std::fixed
               << std::setprecision(2) << result.psnr << " dB, SSIM "
               << std::setprecision(4) << result.ssim << ", " << std::setprecision(3)
-              << result.seconds_per_view << " s/view (" << total_views << " views)\n";
+              << result.seconds_per_view << " s/view (" << total_views
+              << " views); ulr on the same views: " << std::setprecision(2)
+              << result.ulr_psnr << " dB, SSIM " << std::setprecision(4)
+              << result.ulr_ssim << "\n";
   }
   last_validation_ = result;
   has_validation_ = true;
@@ -281,12 +320,16 @@ std::string Trainer::SaveModel() {
     nlohmann::json v = {{"step", last_validation_.step},
                         {"psnr", last_validation_.psnr},
                         {"ssim", last_validation_.ssim},
+                        {"ulr_psnr", last_validation_.ulr_psnr},
+                        {"ulr_ssim", last_validation_.ulr_ssim},
                         {"seconds_per_view", last_validation_.seconds_per_view}};
     for (const auto& r : last_validation_.scenes) {
       v["scenes"].push_back({{"path", r.path},
                              {"views", r.views},
                              {"psnr", r.psnr},
                              {"ssim", r.ssim},
+                             {"ulr_psnr", r.ulr_psnr},
+                             {"ulr_ssim", r.ulr_ssim},
                              {"seconds_per_view", r.seconds_per_view}});
     }
     card["validation"] = v;

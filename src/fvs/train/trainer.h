@@ -26,9 +26,13 @@ struct ValidationResult {
     std::string path;
     int views = 0;
     double psnr = 0, ssim = 0, seconds_per_view = 0;
+    // The `ulr` baseline on the same views, warps and masks (the ULR blend of the
+    // warped sources; black where no source sees the pixel), for comparison.
+    double ulr_psnr = 0, ulr_ssim = 0;
   };
   std::vector<Scene> scenes;
   double psnr = 0, ssim = 0, seconds_per_view = 0;  // means over all views
+  double ulr_psnr = 0, ulr_ssim = 0;
 };
 
 class Trainer {
