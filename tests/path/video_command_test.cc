@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "colmap_ext/image_io.h"
 #include "fvs/path/video.h"
 #include "scene/scene_fixture.h"
 #include "support/test_support.h"
@@ -91,6 +92,16 @@ TEST_F(VideoCommandTest, PathThenVideoThenResume) {
   EXPECT_EQ(resumed["num_resumed"].get<int>(), 7);
   // The earlier rows are kept (coverage known for every frame).
   EXPECT_GT(resumed["mean_coverage"].get<double>(), 0.5);
+  // The chain goes on across the resumed frames: the redone frames have a flicker to
+  // their (resumed) predecessors.
+  const std::string rows = ReadTextFile(frames + "/frame_report.csv");
+  for (const char* frame : {"frame_00003,", "frame_00006,"}) {
+    const size_t at = rows.find(frame);
+    ASSERT_NE(at, std::string::npos) << rows;
+    const std::string row = rows.substr(at, rows.find('\n', at) - at);
+    EXPECT_NE(row.find(",rendered,"), std::string::npos) << row;
+    EXPECT_EQ(row.find(",-1.000000,-1.000000,"), std::string::npos) << row;
+  }
   ASSERT_EQ(Run(render + " --overwrite 1", &out), 0) << out;
   EXPECT_EQ(out.find("resuming"), std::string::npos) << out;
   // Other settings into the same folder: nothing is taken from the earlier frames.
@@ -107,6 +118,62 @@ TEST_F(VideoCommandTest, PathThenVideoThenResume) {
             0)
       << out;
   EXPECT_TRUE(fs::exists(dir_ / "txt/frame_00008.png"));
+}
+
+// Where ground truth exists, the PSNR of every frame goes beside the flicker: the
+// generated scene rendered along a path by view_synthesis_synthetic --camera_path.
+TEST(VideoGroundTruthTest, PsnrBesideFlickerOnTheGeneratedScene) {
+  TempDir dir;
+  const std::string size =
+      " --SyntheticScene.num_views 8 --SyntheticScene.width 96 --SyntheticScene.height "
+      "72";
+  auto run = [&](const std::string& args, std::string* out) {
+    return RunShell("FVS_QUIET=1 " + FrontDoorBinary() + " " + args + " 2>&1", out);
+  };
+  std::string out;
+  ASSERT_EQ(run("view_synthesis_synthetic --output_path " + (dir / "ws") + size +
+                    " --SyntheticScene.write_proxy_mesh 1",
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(run("view_synthesis_path --workspace_path " + (dir / "ws") +
+                    " --output_path " + (dir / "path.json") +
+                    " --keyframes frame_0001.png,frame_0003.png,frame_0005.png --fps 3"
+                    " --seconds_per_keyframe 1",
+                &out),
+            0)
+      << out;
+  ASSERT_EQ(run("view_synthesis_synthetic --output_path " + (dir / "gt") + size +
+                    " --camera_path " + (dir / "path.json"),
+                &out),
+            0)
+      << out;
+  EXPECT_TRUE(fs::exists(dir / "gt/frame_00000.png"));
+  ASSERT_EQ(run("view_synthesis --workspace_path " + (dir / "ws") + " --camera_path " +
+                    (dir / "path.json") + " --output_path " + (dir / "out") +
+                    " --ground_truth_path " + (dir / "gt"),
+                &out),
+            0)
+      << out;
+  const size_t at = out.find("ground truth: PSNR ");
+  ASSERT_NE(at, std::string::npos) << out;
+  const double psnr = std::stod(out.substr(at + 19));
+  // ~26 dB measured (ulr, exact proxy, 96x72); a frame of another camera gives ~12 dB.
+  EXPECT_GT(psnr, 20.0) << out;
+  EXPECT_NE(out.find("flicker:"), std::string::npos) << out;
+  const auto report = nlohmann::json::parse(ReadTextFile(dir / "out/frame_report.json"));
+  EXPECT_EQ(report["num_frames_with_ground_truth"].get<int>(), 7);
+  EXPECT_NEAR(report["mean_psnr"].get<double>(), psnr, 0.01);
+  // A ground truth of another size is not the frame it claims to be.
+  fs::create_directories(dir / "small");
+  colmap::WriteImage(dir / "small/frame_00002.png", Image(48, 36, 3, 0.5f));
+  EXPECT_NE(run("view_synthesis --workspace_path " + (dir / "ws") + " --camera_path " +
+                    (dir / "path.json") + " --output_path " + (dir / "out2") +
+                    " --ground_truth_path " + (dir / "small"),
+                &out),
+            0);
+  EXPECT_NE(out.find("ground truth of 48x36 for a frame of 96x72"), std::string::npos)
+      << out;
 }
 
 TEST_F(VideoCommandTest, WritesMp4WhenFfmpegIsInstalled) {

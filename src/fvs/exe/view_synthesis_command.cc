@@ -4,13 +4,16 @@
 //   --method ulr|nearest|fvs, --num_sources K, --width/--height/--scale,
 //   --write_depth, --write_confidence, --write_sources
 //   videos: --video out.mp4 (ffmpeg when installed), --fps, --stable_sources 1
-//   (--source_hysteresis, --stable_source_order), --temporal_blend a, --flag_coverage c
+//   (--source_hysteresis, --stable_source_order), --temporal_blend a, --flag_coverage c,
+//   --ground_truth_path G (PSNR of every frame that has an image of its name in G)
 // Renders every target into O/<name>.png (plus the optional extras, see render_output.h)
 // and prints a per-target timing summary (depth / selection / warp / blend). A target
 // whose PNG already exists (and has the right size) is skipped unless --overwrite 1, so
 // an interrupted render resumes at the first missing frame. O/frame_report.{csv,json}
-// hold per frame the coverage (flagged under --flag_coverage), the sources and the
-// flicker to the previous frame (fvs/path/flicker.h).
+// hold per frame the coverage (flagged under --flag_coverage), the sources, the flicker
+// to the previous frame (fvs/path/flicker.h) and the PSNR against the ground truth. The
+// temporal chain (stable sources, blend, flicker) goes on across resumed frames: the last
+// frame on disk before a missing one is rendered again, its colour taken from disk.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +26,7 @@
 #include <vector>
 
 #include "colmap_ext/image_io.h"
+#include "fvs/eval/metrics.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/option_manager.h"
 #include "fvs/path/frame_report.h"
@@ -64,6 +68,7 @@ struct ViewSynthesisOptions {
   bool overwrite = false;
   bool stable_sources = false;
   TemporalOptions temporal;
+  std::string ground_truth_path;
 
   void Check() const {
     const int given =
@@ -133,6 +138,40 @@ std::string RenderSettings(const ViewSynthesisOptions& o) {
   return json.dump(2) + "\n";
 }
 
+// The ground-truth image of a frame: <dir>/<name>.png, .jpg or .JPG (empty: none).
+std::string GroundTruthFile(const std::string& dir, const std::string& name) {
+  if (dir.empty()) return "";
+  for (const char* ext : {".png", ".jpg", ".JPG", ".jpeg"}) {
+    const std::string path = JoinPaths(dir, name + ext);
+    if (std::filesystem::exists(path)) return path;
+  }
+  return "";
+}
+
+// PSNR of a rendered frame against its ground truth; -1 without one. A ground truth of
+// another size is an error (it is not the frame it claims to be).
+double FramePsnr(const std::string& dir, const std::string& name, const Image& color) {
+  const std::string path = GroundTruthFile(dir, name);
+  if (path.empty()) return -1;
+  const Image truth = colmap::ReadImage(path);
+  Require(truth.width == color.width && truth.height == color.height, path,
+          "ground truth of " + std::to_string(truth.width) + "x" +
+              std::to_string(truth.height) + " for a frame of " +
+              std::to_string(color.width) + "x" + std::to_string(color.height));
+  return eval::Psnr(color, truth);
+}
+
+std::vector<int> ParseSources(const std::string& text) {
+  std::vector<int> out;
+  for (const std::string& s : SplitString(text, ";")) {
+    try {
+      if (!s.empty()) out.push_back(std::stoi(s));
+    } catch (const std::exception&) {
+    }
+  }
+  return out;
+}
+
 std::vector<TargetCamera> LoadTargets(const ViewSynthesisOptions& o, const Scene& scene) {
   if (!o.target_images.empty()) return ReadTargetImagesTxt(o.target_images, scene);
   if (!o.camera_path.empty()) return ReadNerfstudioCameraPath(o.camera_path);
@@ -195,6 +234,9 @@ int RunViewSynthesis(int argc, char** argv) {
                      "geometry agrees (0: off)");
   options.AddDefault("flag_coverage", &o.temporal.coverage_threshold,
                      "frames with less coverage are flagged in frame_report.csv");
+  options.AddDefault("ground_truth_path", &o.ground_truth_path,
+                     "folder of ground-truth frames named as the output "
+                     "(<name>.png/.jpg): PSNR per frame in frame_report.csv");
   options.AddDefault("shard", &o.shard,
                      "i/n: render only targets i, i+n, i+2n, ... (Slurm/Kubernetes array "
                      "jobs; file names stay those of the full path)");
@@ -215,7 +257,8 @@ int RunViewSynthesis(int argc, char** argv) {
   std::vector<TargetCamera> targets = LoadTargets(o, scene);
   if (const Shard shard = Shard::Parse(o.shard); !shard.IsAll()) {
     std::vector<TargetCamera> mine;
-    for (int i : shard.Items(static_cast<int>(targets.size()))) mine.push_back(targets[i]);
+    for (int i : shard.Items(static_cast<int>(targets.size())))
+      mine.push_back(targets[i]);
     if (mine.empty()) {
       std::printf("shard %s: no targets (the path has %zu)\n", o.shard.c_str(),
                   targets.size());
@@ -281,6 +324,34 @@ int RunViewSynthesis(int argc, char** argv) {
   std::vector<RenderTimings> timings;
   std::vector<double> coverage;
   std::vector<size_t> rendered;  // indices into targets
+  auto make_view = [&](size_t k) {
+    const TargetCamera& t = targets[k];
+    TargetView view;
+    view.name = t.name;
+    view.camera = scene.ToSceneCamera(cameras[k]);
+    Require(view.camera.IsValid(), t.name, "invalid target camera");
+    if (o.holdout && !t.image_name.empty()) {
+      const int index = scene.FindView(t.image_name);
+      if (index >= 0) view.exclude_views.push_back(index);
+    }
+    return view;
+  };
+  // The frame before a missing one was resumed from disk: render it again (with the
+  // sources its report row names preferred) and continue the chain from its colour on
+  // disk, so that resuming does not restart the stable sources, blend and flicker.
+  auto restore_chain = [&](size_t k) {
+    TargetView view = make_view(k);
+    const auto it = earlier.find(targets[k].name);
+    if (it != earlier.end()) view.preferred_sources = ParseSources(it->second.sources);
+    RenderResult result = method->Render(scene, view);
+    try {
+      result.color =
+          colmap::ReadImage(JoinPaths(o.output_path, targets[k].name + ".png"));
+    } catch (const Error&) {
+      return;  // unreadable after all: the chain restarts
+    }
+    sequence.Remember(view, result);
+  };
   Progress progress("view_synthesis " + o.method, to_render);
   for (size_t k = 0; k < targets.size(); ++k) {
     const TargetCamera& t = targets[k];
@@ -293,20 +364,15 @@ int RunViewSynthesis(int argc, char** argv) {
       report.push_back(row);
       continue;
     }
-    TargetView view;
-    view.name = t.name;
-    view.camera = scene.ToSceneCamera(cameras[k]);
-    Require(view.camera.IsValid(), t.name, "invalid target camera");
-    if (o.holdout && !t.image_name.empty()) {
-      const int index = scene.FindView(t.image_name);
-      if (index >= 0) view.exclude_views.push_back(index);
-    }
+    if (k > 0 && done[k - 1]) restore_chain(k - 1);
+    TargetView view = make_view(k);
     sequence.PrepareView(&view);
     Timer frame_timer;
     RenderResult result = method->Render(scene, view);
     FrameReportRow row = sequence.Finish(view, &result);
     WriteRenderOutputs(o.output_path, t.name, o.method, scene, result, o.output);
     row.seconds = frame_timer.Seconds();
+    row.psnr = FramePsnr(o.ground_truth_path, t.name, result.color);
     report.push_back(row);
     timings.push_back(result.timings);
     coverage.push_back(row.coverage);
@@ -355,6 +421,14 @@ int RunViewSynthesis(int argc, char** argv) {
         "blend + flicker)\n",
         summary.mean_flicker, summary.mean_source_changes, 1000 * summary.mean_seconds,
         1000 * summary.mean_temporal_seconds);
+  }
+  if (summary.num_psnr > 0) {
+    std::printf("ground truth: PSNR %.2f dB over %d of %d frames (%s)\n",
+                summary.mean_psnr, summary.num_psnr, summary.num_frames,
+                o.ground_truth_path.c_str());
+  } else if (!o.ground_truth_path.empty()) {
+    std::printf("ground truth: no frame has an image in %s\n",
+                o.ground_truth_path.c_str());
   }
   if (!o.video.empty()) {
     std::vector<std::string> frames;

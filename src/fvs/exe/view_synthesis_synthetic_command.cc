@@ -6,6 +6,7 @@
 
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/option_manager.h"
+#include "fvs/render/targets.h"
 #include "fvs/synthetic/generate.h"
 #include "fvs/util/error.h"
 #include "fvs/util/progress.h"
@@ -15,6 +16,7 @@ namespace {
 
 int RunViewSynthesisSynthetic(int argc, char** argv) {
   std::string output_path;
+  std::string camera_path;
   SyntheticSceneOptions scene;
   int seed = 0;
   OptionManager options(
@@ -22,6 +24,10 @@ int RunViewSynthesisSynthetic(int argc, char** argv) {
       "Generates a synthetic textured scene with exact ground truth (images, "
       "sparse model, depth and normal maps, mesh) as a COLMAP workspace.");
   options.AddRequired("output_path", &output_path, "folder to write the scene to");
+  options.AddDefault("camera_path", &camera_path,
+                     "nerfstudio camera_path.json in the scene's frame: write only the "
+                     "ground truth of its frames (<frame>.png), e.g. of a video "
+                     "rendered from the generated workspace");
   options.AddDefault("SyntheticScene.num_views", &scene.num_views, "number of views");
   options.AddDefault("SyntheticScene.width", &scene.width, "image width in pixels");
   options.AddDefault("SyntheticScene.height", &scene.height, "image height in pixels");
@@ -43,6 +49,17 @@ int RunViewSynthesisSynthetic(int argc, char** argv) {
   scene.Check();
 
   Timer timer;
+  if (!camera_path.empty()) {
+    std::vector<std::pair<std::string, PinholeCamera>> frames;
+    for (const TargetCamera& t : ReadNerfstudioCameraPath(camera_path)) {
+      frames.emplace_back(t.name, t.camera);
+    }
+    RenderSyntheticFrames(scene, frames, output_path);
+    std::cout << "Wrote the ground truth of " << frames.size() << " frames of "
+              << camera_path << " to " << output_path << " in " << timer.Seconds() << " s"
+              << std::endl;
+    return 0;
+  }
   GenerateSyntheticScene(scene, output_path);
   std::cout << "Wrote a synthetic scene of " << scene.num_views << " views ("
             << scene.width << "x" << scene.height << ", seed " << scene.seed << ") to "

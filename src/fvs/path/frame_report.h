@@ -1,8 +1,9 @@
 // The per-frame report of a rendered video (O/frame_report.csv and a summary in
 // O/frame_report.json): coverage of every frame, frames flagged under a coverage
 // threshold, the sources used and how many changed since the previous frame, the flicker
-// to the previous frame and the render time. A resumed render keeps the rows of the
-// frames it skipped from the previous report.
+// to the previous frame, the PSNR against a ground-truth image where there is one and the
+// render time. A resumed render keeps the rows of the frames it skipped from the previous
+// report.
 #pragma once
 
 #include <map>
@@ -20,6 +21,7 @@ struct FrameReportRow {
   int source_changes = -1;          // sources not used by the previous frame; -1 unknown
   double flicker = -1;              // 8-bit levels to the previous frame; -1 unknown
   double covisible = -1;            // fraction of pixels compared for the flicker
+  double psnr = -1;                 // dB against the ground-truth frame; -1 none
   double seconds = -1;              // render time, all included
   double temporal_seconds = -1;     // of which the temporal blend and flicker
 };
@@ -33,6 +35,8 @@ struct FrameReportSummary {
   double mean_coverage = 0;  // over frames with a known coverage
   double mean_flicker = -1;  // over known pairs, weighted by compared pixels
   double mean_source_changes = -1;
+  double mean_psnr = -1;  // over frames with ground truth
+  int num_psnr = 0;
   double mean_seconds = -1;           // per rendered frame
   double mean_temporal_seconds = -1;  // of which blend + flicker
 };

@@ -78,18 +78,23 @@ FrameReportRow TemporalSequence::Finish(const TargetView& view, RenderResult* re
     row.flicker = pair.mean_abs;
     row.covisible = pair.covisible_fraction;
   }
-  if (sized) {
-    has_previous_ = true;
-    previous_camera_ = view.camera;
-    previous_color_ = result->color;
-    previous_depth_ = result->depth;
-    previous_coverage_ = result->coverage;
-    previous_sources_ = sources;
-  } else {
-    has_previous_ = false;
-  }
+  Remember(view, *result);
   row.temporal_seconds = timer.Seconds();
   return row;
+}
+
+void TemporalSequence::Remember(const TargetView& view, const RenderResult& result) {
+  const int n = view.camera.width * view.camera.height;
+  has_previous_ = static_cast<int>(result.depth.data.size()) == n &&
+                  static_cast<int>(result.coverage.data.size()) == n &&
+                  static_cast<int>(result.color.data.size()) == 3 * n;
+  if (!has_previous_) return;
+  previous_camera_ = view.camera;
+  previous_color_ = result.color;
+  previous_depth_ = result.depth;
+  previous_coverage_ = result.coverage;
+  previous_sources_.clear();
+  for (const SourceScore& s : result.sources) previous_sources_.push_back(s.view_index);
 }
 
 }  // namespace fvs

@@ -5,7 +5,8 @@
 //     (target depths and poses, occlusion-checked: flicker.h) where both see the surface,
 //     weight `temporal_blend` for the previous frame;
 //   - the flicker of every frame to the previous one, for the per-frame report.
-// A frame that is not rendered (resumed from disk) breaks the chain: Reset().
+// A frame that is not rendered (resumed from disk) breaks the chain: Reset(), or
+// Remember() it (re-rendered, with its colour from disk) so that the chain goes on.
 #pragma once
 
 #include <vector>
@@ -34,6 +35,9 @@ class TemporalSequence {
   // row has everything but the timing filled. `result` must come from rendering `view`.
   FrameReportRow Finish(const TargetView& view, RenderResult* result);
   void Reset() { has_previous_ = false; }
+  // Takes `result` (rendered for `view`) as the previous frame as it is: no blend, no
+  // measurement.
+  void Remember(const TargetView& view, const RenderResult& result);
 
  private:
   TemporalOptions options_;

@@ -105,4 +105,35 @@ void GenerateSyntheticScene(const SyntheticSceneOptions& options,
                   [&](std::ostream& out) { out << info.dump(2) << "\n"; });
 }
 
+void RenderSyntheticFrames(
+    const SyntheticSceneOptions& options,
+    const std::vector<std::pair<std::string, PinholeCamera>>& frames,
+    const std::string& output_dir) {
+  options.Check();
+  for (const auto& [name, camera] : frames) {
+    Require(camera.IsValid(), name, "invalid camera");
+  }
+  colmap::CreateDirectories(output_dir);
+  const SyntheticScene scene = BuildSyntheticScene(options);
+  Progress progress("Rendering ground-truth frames", static_cast<int64_t>(frames.size()));
+  for (const auto& [name, camera] : frames) {
+    const std::string path = output_dir + "/" + name + ".png";
+    int w = 0, h = 0;
+    bool done = false;
+    try {
+      colmap::ReadImageSize(path, &w, &h);
+      done = w == camera.width && h == camera.height;
+    } catch (const Error&) {
+    }
+    if (!done) {
+      Image color, depth, normals;
+      RenderSyntheticView(scene, camera, &color, &depth, &normals);
+      CheckFinite(color, path);
+      colmap::WriteImage(path, color);
+    }
+    progress.Advance();
+  }
+  progress.Finish();
+}
+
 }  // namespace fvs

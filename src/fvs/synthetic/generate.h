@@ -12,6 +12,8 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "fvs/synthetic/synthetic_scene.h"
 
@@ -20,6 +22,15 @@ namespace fvs {
 // Throws fvs::Error on bad options or when a file cannot be written.
 void GenerateSyntheticScene(const SyntheticSceneOptions& options,
                             const std::string& output_dir);
+
+// Ground truth for a camera path (e.g. a video rendered from the workspace above, whose
+// frame is the scene's): the scene the options make, rendered at every camera into
+// DIR/<name>.png. The cameras must lie in the scene's world frame. Frames already there
+// with the right size are kept (a killed run resumes).
+void RenderSyntheticFrames(
+    const SyntheticSceneOptions& options,
+    const std::vector<std::pair<std::string, PinholeCamera>>& frames,
+    const std::string& output_dir);
 
 // Paths of the files above (for stages and tests that read them).
 std::string SyntheticDepthMapPath(const std::string& output_dir, const std::string& name);
