@@ -142,6 +142,42 @@ TEST_F(ViewSynthesisCommandTest, OrbitInterpolateAndCameraPath) {
   EXPECT_EQ(colmap::ReadImage(dir_ / "path/frame_00000.png").width, 48);
 }
 
+// --shard i/n (batch array jobs): each shard renders every n-th frame under the full
+// path's names and writes its own report; together they are the unsharded render, pixel
+// for pixel.
+TEST_F(ViewSynthesisCommandTest, ShardsTogetherAreTheFullRender) {
+  std::string output;
+  ASSERT_EQ(Run("--orbit 5 --scale 0.5 --output_path " + dir_ / "full", &output), 0)
+      << output;
+  for (const char* shard : {"0/2", "1/2"}) {
+    ASSERT_EQ(Run("--orbit 5 --scale 0.5 --shard " + std::string(shard) +
+                      " --output_path " + dir_ / "sharded",
+                  &output),
+              0)
+        << output;
+  }
+  for (int i = 0; i < 5; ++i) {
+    const std::string name = "frame_0000" + std::to_string(i) + ".png";
+    ASSERT_TRUE(fs::exists(dir_ / ("sharded/" + name))) << name;
+    EXPECT_EQ(colmap::ReadImage(dir_ / ("sharded/" + name)).data,
+              colmap::ReadImage(dir_ / ("full/" + name)).data)
+        << name;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "sharded/frame_00005.png"));
+  // One report per shard, with its own frames only.
+  const auto first = nlohmann::json::parse(
+      testing::ReadTextFile(dir_ / "sharded/frame_report.shard_0_2.json"));
+  const auto second = nlohmann::json::parse(
+      testing::ReadTextFile(dir_ / "sharded/frame_report.shard_1_2.json"));
+  EXPECT_EQ(first["num_frames"].get<int>(), 3);
+  EXPECT_EQ(second["num_frames"].get<int>(), 2);
+  // A shard past the end renders nothing and says so; a malformed one is an error.
+  ASSERT_EQ(Run("--orbit 2 --shard 3/4 --output_path " + dir_ / "empty", &output), 0)
+      << output;
+  EXPECT_NE(output.find("no targets"), std::string::npos) << output;
+  EXPECT_NE(Run("--orbit 2 --shard 2/2 --output_path " + dir_ / "bad", &output), 0);
+}
+
 TEST_F(ViewSynthesisCommandTest, BadInputIsOneLineAndNonZeroExit) {
   std::string output;
   auto expect_failure = [&](const std::string& args, const std::string& fragment) {
