@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "fvs/geometry/look_at.h"
 #include "fvs/geometry/ply.h"
 #include "fvs/geometry/rasterizer.h"
 #include "fvs/util/machine.h"
@@ -115,20 +116,7 @@ TriangleMesh Room(double half, double height, int n) {
 }
 
 PinholeCamera LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-  PinholeCamera c;
-  c.width = 960;
-  c.height = 540;
-  c.fx = c.fy = 700;
-  c.cx = 480;
-  c.cy = 270;
-  const Eigen::Vector3d z = (target - eye).normalized();
-  const Eigen::Vector3d x = Eigen::Vector3d(0, 0, -1).cross(z).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  c.R.row(0) = x.transpose();
-  c.R.row(1) = y.transpose();
-  c.R.row(2) = z.transpose();
-  c.t = -c.R * eye;
-  return c;
+  return fvs::LookAtCamera(eye, target, 960, 540, 700);
 }
 
 double LoadAverage() {

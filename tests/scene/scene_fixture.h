@@ -15,6 +15,7 @@
 #include "colmap_ext/image_io.h"
 #include "colmap_ext/reconstruction.h"
 #include "colmap_ext/sparse_io.h"
+#include "fvs/geometry/look_at.h"
 #include "fvs/geometry/ply.h"
 #include "fvs/geometry/quad_grid.h"
 #include "fvs/geometry/rasterizer.h"
@@ -55,21 +56,7 @@ inline TriangleMesh MakeTestWorldMesh(
 inline PinholeCamera LookAtCamera(const Eigen::Vector3d& eye,
                                   const Eigen::Vector3d& target, int width, int height,
                                   double focal_factor = 0.8) {
-  PinholeCamera c;
-  c.width = width;
-  c.height = height;
-  c.fx = c.fy = focal_factor * width;
-  c.cx = 0.5 * width;
-  c.cy = 0.5 * height;
-  const Eigen::Vector3d z = (target - eye).normalized();
-  const Eigen::Vector3d x =
-      Eigen::Vector3d(0, 0, -1).cross(z).normalized();  // world z up
-  const Eigen::Vector3d y = z.cross(x);
-  c.R.row(0) = x.transpose();
-  c.R.row(1) = y.transpose();
-  c.R.row(2) = z.transpose();
-  c.t = -c.R * eye;
-  return c;
+  return ::fvs::LookAtCamera(eye, target, width, height, focal_factor * width);
 }
 
 // The camera of arc position a (radians) around the box, at eye height.

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "fvs/geometry/look_at.h"
 #include "fvs/geometry/quad_grid.h"
 #include "fvs/geometry/rasterizer.h"
 #include "fvs/scene/scene.h"
@@ -37,20 +38,7 @@ TriangleMesh MakeWorld(bool far_backdrop) {
 
 PinholeCamera LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& at, int width,
                      int height) {
-  PinholeCamera c;
-  c.width = width;
-  c.height = height;
-  c.fx = c.fy = 0.8 * width;
-  c.cx = 0.5 * width;
-  c.cy = 0.5 * height;
-  const Eigen::Vector3d z = (at - eye).normalized();
-  const Eigen::Vector3d x = Eigen::Vector3d(0, 0, -1).cross(z).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  c.R.row(0) = x.transpose();
-  c.R.row(1) = y.transpose();
-  c.R.row(2) = z.transpose();
-  c.t = -c.R * eye;
-  return c;
+  return LookAtCamera(eye, at, width, height, 0.8 * width);
 }
 
 PinholeCamera ArcCamera(double angle, int width, int height) {

@@ -6,6 +6,7 @@
 #include <random>
 #include <unordered_map>
 
+#include "fvs/geometry/look_at.h"
 #include "fvs/util/parallel.h"
 
 namespace fvs::mvs {
@@ -162,24 +163,6 @@ bool MeshingScene::Sees(size_t k, const Eigen::Vector3d& p) const {
   const Eigen::Vector3d c = camera.Center();
   // Unoccluded when nothing is hit before the point (1e-6 relative slack for rounding).
   return FirstHit(c, p - c) >= 1.0 - 1e-6;
-}
-
-PinholeCamera LookAtCamera(const Eigen::Vector3d& position, const Eigen::Vector3d& target,
-                           int width, int height, double focal) {
-  const Eigen::Vector3d z = (target - position).normalized();
-  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  PinholeCamera camera;
-  camera.width = width;
-  camera.height = height;
-  camera.fx = camera.fy = focal;
-  camera.cx = width / 2.0;
-  camera.cy = height / 2.0;
-  camera.R.row(0) = x.transpose();
-  camera.R.row(1) = y.transpose();
-  camera.R.row(2) = z.transpose();
-  camera.t = -camera.R * position;
-  return camera;
 }
 
 MeshingScene MakeRoomScene(int num_cameras, int width, int height) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fvs/geometry/camera.h"
+#include "fvs/geometry/look_at.h"
 #include "fvs/geometry/mesh.h"
 #include "fvs/mvs/delaunay.h"
 
@@ -48,9 +49,6 @@ struct MeshingScene {
 MeshingScene MakeRoomScene(int num_cameras, int width = 320, int height = 240);
 // A sphere and a box seen from a ring of cameras outside them.
 MeshingScene MakeObjectScene(int num_cameras, int width = 320, int height = 240);
-
-PinholeCamera LookAtCamera(const Eigen::Vector3d& position, const Eigen::Vector3d& target,
-                           int width, int height, double focal);
 
 struct SampledCloud {
   DelaunayMeshingInput input;  // noisy points + outliers, visibility, cameras

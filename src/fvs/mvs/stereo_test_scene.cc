@@ -11,6 +11,7 @@
 #include "colmap_ext/reconstruction.h"
 #include "colmap_ext/sparse_io.h"
 #include "colmap_ext/workspace.h"
+#include "fvs/geometry/look_at.h"
 #include "fvs/util/error.h"
 #include "fvs/util/parallel.h"
 
@@ -94,22 +95,11 @@ double CastRay(const std::vector<Quad>& quads, const Eigen::Vector3d& origin,
   return best;
 }
 
+// Image y along world +y: up = -y.
 PinholeCamera LookAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target,
                      int width, int height) {
-  PinholeCamera c;
-  c.width = width;
-  c.height = height;
-  c.fx = c.fy = 0.9 * width;
-  c.cx = 0.5 * width;
-  c.cy = 0.5 * height;
-  const Eigen::Vector3d z = (target - center).normalized();
-  const Eigen::Vector3d x = Eigen::Vector3d(0, 1, 0).cross(z).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  c.R.row(0) = x.transpose();
-  c.R.row(1) = y.transpose();
-  c.R.row(2) = z.transpose();
-  c.t = -c.R * center;
-  return c;
+  return LookAtCamera(center, target, width, height, 0.9 * width,
+                      -Eigen::Vector3d::UnitY());
 }
 
 }  // namespace
