@@ -206,7 +206,10 @@ TEST(FvsNetTest, RgbSkipStartsAsThePriorBlendOfTheWarpedSources) {
   const torch::Tensor encoded = net->Encode(in.images);
   EXPECT_TRUE(
       torch::equal(encoded.narrow(1, net->config().feature_channels, 3), in.images));
-  const torch::Tensor warped_rgb = WarpFeatures(in.images, in.grid);
+  // Sources that do not see a pixel offer black there.
+  const torch::Tensor warped_rgb =
+      torch::where(in.valid_warp > 0.5, WarpFeatures(in.images, in.grid),
+                   torch::full({1}, -1.0f));
   const torch::Tensor w =
       torch::exp(mask_prior * (in.valid_warp - 1) + ulr_prior * in.ulr);
   const torch::Tensor expected =

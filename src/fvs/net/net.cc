@@ -306,7 +306,17 @@ BlendOutput FvsNetImpl::Blend(const torch::Tensor& warped,
     if (config_.soft_argmax) {
       torch::Tensor rgb = rgb_head_(top);
       if (config_.rgb_skip) {
-        rgb = rgb + warped.narrow(0, first, count).narrow(1, config_.feature_channels, 3);
+        torch::Tensor skip =
+            warped.narrow(0, first, count).narrow(1, config_.feature_channels, 3);
+        if (config_.use_masks) {
+          // A source that does not see the pixel offers black, not what happens to lie
+          // at its warped position (an occluder, or nothing): where no source sees a
+          // pixel the untrained net renders black, as `ulr` does.
+          const torch::Tensor seen =
+              valid_warp.narrow(0, first, count).to(skip.options()) > 0.5;
+          skip = torch::where(seen, skip, torch::full_like(skip, -1.0));
+        }
+        rgb = rgb + skip;
       }
       torch::Tensor confidence = confidence_head_(top);
       if (config_.mask_prior > 0) {
