@@ -56,5 +56,5 @@ ls -d packed/* | grep -v -e middlebury_temple -e /fox > train.txt
 
 exec nice -n 19 env FVS_NUM_THREADS="$(nproc)" bin/colmap view_synthesis_train \
   --scene_list train.txt --val_scene_list val.txt --output_path runs/fvs_fast_ulr \
-  --Train.variant fvs_fast --Train.crop 128 --Train.max_steps 200000 \
+  --Train.variant fvs_fast --Train.crop 128 --Train.max_steps 200000 --Train.learning_rate 5e-4 \
   --Train.val_every 250 --Train.val_views 3 --Train.log_every 10 --Train.checkpoint_minutes 10

@@ -128,6 +128,7 @@ std::string RenderSettings(const ViewSynthesisOptions& o) {
   json["source_hysteresis"] = o.render.source_hysteresis;
   json["stable_source_order"] = o.render.stable_source_order;
   json["temporal_blend"] = o.temporal.temporal_blend;
+  json["fill_holes"] = o.render.fill_holes;
   json["targets"] = !o.target_images.empty() ? "target_images " + o.target_images
                     : !o.camera_path.empty() ? "camera_path " + o.camera_path
                     : o.orbit > 0            ? "orbit " + std::to_string(o.orbit)
@@ -212,6 +213,9 @@ int RunViewSynthesis(int argc, char** argv) {
                      "also write <name>.confidence.png");
   options.AddDefault("write_sources", &o.output.write_sources,
                      "also write <name>.sources.json");
+  options.AddDefault("fill_holes", &o.render.fill_holes,
+                     "fill pixels no source sees from the covered pixels around them "
+                     "(0: leave them black; frame_report.csv counts them either way)");
   options.AddDefault("num_threads", &o.render.num_threads, "threads (0: all cores)");
   options.AddDefault(
       "video", &o.video,

@@ -50,6 +50,7 @@ struct EvalCommandOptions {
   int thumbnail_width = 320;
   bool write_images = false;
   int num_threads = 0;
+  bool fill_holes = true;
 
   void Check() const {
     protocol.Check();
@@ -137,6 +138,9 @@ int RunViewSynthesisEval(int argc, char** argv) {
                      "contact sheet tile width (0: no contact sheet)");
   options.AddDefault("write_images", &o.write_images,
                      "also write every render to O/renders/<configuration>/");
+  options.AddDefault("fill_holes", &o.fill_holes,
+                     "fill pixels no source sees from around them (0: black; the "
+                     "covered-pixel scores are the same either way)");
   options.AddDefault("num_threads", &o.num_threads, "threads (0: all cores)");
   if (!options.Parse(argc, argv)) return 0;
   o.Check();
@@ -147,6 +151,7 @@ int RunViewSynthesisEval(int argc, char** argv) {
   std::vector<std::string> notes;
   EvalRunOptions run;
   run.render.num_threads = o.num_threads;
+  run.render.fill_holes = o.fill_holes;
   if (o.sweep) {
     SweepOptions sweep = o.sweep_options;
     if (!o.config.model_path.empty()) {

@@ -8,6 +8,8 @@
 #include "fvs/render/fvs_method.h"
 #include "fvs/render/ulr.h"
 #include "fvs/util/error.h"
+#include "fvs/util/hole_filling.h"
+#include "fvs/util/progress.h"
 
 namespace fvs {
 
@@ -26,6 +28,29 @@ void RenderOptions::Check() const {
 }
 
 namespace {
+
+// Any method, its holes filled afterwards (the same for every method, so comparisons
+// between methods stay fair).
+class HoleFillingMethod : public Method {
+ public:
+  explicit HoleFillingMethod(std::unique_ptr<Method> inner) : inner_(std::move(inner)) {}
+  std::string name() const override { return inner_->name(); }
+  RenderResult Render(const Scene& scene, const TargetView& target) override {
+    RenderResult result = inner_->Render(scene, target);
+    if (!result.color.empty() && result.coverage.width == result.color.width &&
+        result.coverage.height == result.color.height) {
+      Timer timer;
+      const bool sized = result.depth.width == result.color.width &&
+                         result.depth.height == result.color.height;
+      FillHoles(result.coverage, sized ? &result.depth : nullptr, &result.color);
+      result.timings.blend_s += timer.Seconds();
+    }
+    return result;
+  }
+
+ private:
+  std::unique_ptr<Method> inner_;
+};
 
 struct Registry {
   std::mutex mutex;
@@ -90,7 +115,9 @@ std::unique_ptr<Method> CreateMethod(const std::string& name,
       known += (known.empty() ? "" : ", ") + n;
     throw Error("--method " + name, "unknown method (known: " + known + ", fvs)");
   }
-  return factory(options);
+  std::unique_ptr<Method> method = factory(options);
+  if (!options.fill_holes) return method;
+  return std::make_unique<HoleFillingMethod>(std::move(method));
 }
 
 }  // namespace fvs

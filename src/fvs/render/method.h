@@ -46,6 +46,9 @@ struct RenderOptions {
   // Feed the selected sources in view order rather than best first, so that the
   // recurrent blend sees a fixed order while the set does not change.
   bool stable_source_order = false;
+  // Pixels no source sees get colours pushed and pulled from the covered pixels around
+  // them (render/hole_filling.h) instead of black; coverage and confidence stay 0 there.
+  bool fill_holes = true;
   void Check() const;
 };
 
@@ -59,7 +62,8 @@ struct RenderTimings {
 };
 
 struct RenderResult {
-  Image color;       // 3 channels in [0, 1], black where no source sees the pixel
+  Image color;       // 3 channels in [0, 1]; where no source sees the pixel: black, or
+                     // filled from around it (RenderOptions::fill_holes)
   Image depth;       // 1 channel, target depth from the mesh (0 = no surface)
   Image confidence;  // 1 channel in [0, 1]; 0 where not covered
   Image coverage;    // 1 channel, 1 where at least one source contributed

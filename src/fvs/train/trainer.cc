@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
+#include "fvs/util/hole_filling.h"
 #include "fvs/util/machine.h"
 #include "fvs/util/parallel.h"
 #include "fvs/util/progress.h"
@@ -83,6 +85,28 @@ DeviceSample ToDevice(const TrainingSample& s, const torch::Device& device) {
           to(s.warp.valid_depth), to(s.warp.valid_warp), to(s.warp.ulr_log_weights)};
 }
 
+// FillHoles on a [1,3,H,W] image in [0,1]; covered and surface are [1,1,H,W] (> 0 = yes).
+torch::Tensor FillHolesOf(const torch::Tensor& rgb, const torch::Tensor& covered,
+                          const torch::Tensor& surface) {
+  const int64_t h = rgb.size(2), w = rgb.size(3);
+  auto to_image = [&](const torch::Tensor& t, int channels) {
+    const torch::Tensor hwc =
+        t.to(torch::kCPU, torch::kFloat).squeeze(0).permute({1, 2, 0}).contiguous();
+    Image image(static_cast<int>(w), static_cast<int>(h), channels);
+    std::memcpy(image.data.data(), hwc.data_ptr<float>(),
+                image.data.size() * sizeof(float));
+    return image;
+  };
+  Image color = to_image(rgb, 3);
+  const Image coverage = to_image(covered, 1), depth = to_image(surface, 1);
+  FillHoles(coverage, &depth, &color);
+  return torch::from_blob(color.data.data(), {h, w, 3}, torch::kFloat)
+      .permute({2, 0, 1})
+      .unsqueeze(0)
+      .clone()
+      .to(rgb.device());
+}
+
 void SetUlrPrior(const ModelConfig& config, WarpSettings* warp) {
   warp->ulr_log_weights = config.ulr_prior > 0;
   warp->ulr.num_blend = config.ulr_num_blend;
@@ -147,7 +171,11 @@ LossValue Trainer::Step() {
     const DeviceSample s = ToDevice(sampler_->Next(), device_);
     const BlendOutput out =
         net_->Forward(s.sources, s.grid, s.valid_depth, s.valid_warp, s.ulr_log_weights);
-    const torch::Tensor prediction01 = (out.rgb + 1.0) * 0.5;
+    // Pixels no source sees are filled classically at render time (util/hole_filling.h):
+    // the net is not asked to invent them (it would learn the training set's sky).
+    const torch::Tensor seen = s.valid_warp.sum(0, true) > 0;
+    const torch::Tensor prediction01 =
+        torch::where(seen, (out.rgb + 1.0) * 0.5, s.target);
     LossValue loss = (*loss_)(prediction01, s.target);
     Require(std::isfinite(loss.l1) && std::isfinite(loss.second), "view_synthesis_train",
             "the loss became NaN or Inf at step " + std::to_string(step_ + 1) +
@@ -190,7 +218,10 @@ ValidationResult Trainer::Validate() {
       const DeviceSample s = ToDevice(sample, device_);
       const BlendOutput out = net_->Forward(s.sources, s.grid, s.valid_depth,
                                             s.valid_warp, s.ulr_log_weights);
-      const torch::Tensor prediction = ((out.rgb + 1.0) * 0.5).clamp(0.0, 1.0);
+      const torch::Tensor covered = s.valid_warp.sum(0, true) > 0;
+      // As the renderer: holes (no source sees the pixel) filled from around them.
+      const torch::Tensor prediction =
+          FillHolesOf(((out.rgb + 1.0) * 0.5).clamp(0.0, 1.0), covered, s.valid_depth);
       if (device_.is_cuda()) torch::cuda::synchronize();
       seconds += timer.Seconds();
       auto psnr = [&](const torch::Tensor& image) {
@@ -199,13 +230,13 @@ ValidationResult Trainer::Validate() {
       };
       r.psnr += psnr(prediction);
       r.ssim += Ssim(prediction, s.target).item<double>();
-      const torch::Tensor seen = (s.valid_warp.sum(0, true) > 0).to(torch::kFloat);
-      const torch::Tensor ulr =
+      const torch::Tensor ulr = FillHolesOf(
           (((SoftmaxWeights(s.ulr_log_weights) * WarpFeatures(s.sources, s.grid))
                 .sum(0, true) +
             1.0) *
-           0.5 * seen)
-              .clamp(0.0, 1.0);
+           0.5)
+              .clamp(0.0, 1.0),
+          covered, s.valid_depth);
       r.ulr_psnr += psnr(ulr);
       r.ulr_ssim += Ssim(ulr, s.target).item<double>();
       ++r.views;

@@ -27,7 +27,7 @@ struct ValidationResult {
     int views = 0;
     double psnr = 0, ssim = 0, seconds_per_view = 0;
     // The `ulr` baseline on the same views, warps and masks (the ULR blend of the
-    // warped sources; black where no source sees the pixel), for comparison.
+    // warped sources, holes filled as the renderer fills them), for comparison.
     double ulr_psnr = 0, ulr_ssim = 0;
   };
   std::vector<Scene> scenes;
