@@ -93,7 +93,10 @@ std::ifstream OpenText(const std::string& path) {
   return in;
 }
 
-void ReadCameras(const std::string& path, Reconstruction* rec) {
+// Calls record(tokens, in, &line_number) for every line that is neither empty nor a
+// comment; `record` may read further lines of the record from `in`.
+template <typename Record>
+void ForEachRecord(const std::string& path, Record record) {
   std::ifstream in = OpenText(path);
   std::string line;
   int line_number = 0;
@@ -102,6 +105,23 @@ void ReadCameras(const std::string& path, Reconstruction* rec) {
     line = TrimLine(line);
     if (line.empty() || line[0] == '#') continue;
     LineTokens tokens(path, line_number, line);
+    record(tokens, in, &line_number);
+  }
+  if (in.bad()) throw Error(path, "read failed");
+}
+
+// Runs one of the internal::Check* validators and reports its complaint on the line.
+template <typename Check>
+void CheckOnLine(const LineTokens& tokens, const std::string& path, Check check) {
+  try {
+    check();
+  } catch (const Error& e) {
+    tokens.Fail(std::string(e.what()).substr(path.size() + 2));
+  }
+}
+
+void ReadCameras(const std::string& path, Reconstruction* rec) {
+  ForEachRecord(path, [&](LineTokens& tokens, std::ifstream&, int*) {
     Camera camera;
     camera.camera_id = tokens.Unsigned("camera id", UINT32_MAX);
     const std::string model = tokens.Next("camera model");
@@ -110,27 +130,15 @@ void ReadCameras(const std::string& path, Reconstruction* rec) {
     camera.width = tokens.Unsigned("camera width", UINT64_MAX);
     camera.height = tokens.Unsigned("camera height", UINT64_MAX);
     while (!tokens.done()) camera.params.push_back(tokens.Double("camera parameter"));
-    try {
-      internal::CheckCamera(camera, path);
-    } catch (const Error& e) {
-      tokens.Fail(std::string(e.what()).substr(path.size() + 2));
-    }
+    CheckOnLine(tokens, path, [&] { internal::CheckCamera(camera, path); });
     if (!rec->cameras.emplace(camera.camera_id, camera).second) {
       tokens.Fail("duplicate camera id " + std::to_string(camera.camera_id));
     }
-  }
-  if (in.bad()) throw Error(path, "read failed");
+  });
 }
 
 void ReadImages(const std::string& path, Reconstruction* rec) {
-  std::ifstream in = OpenText(path);
-  std::string line;
-  int line_number = 0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    line = TrimLine(line);
-    if (line.empty() || line[0] == '#') continue;
-    LineTokens tokens(path, line_number, line);
+  ForEachRecord(path, [&](LineTokens& tokens, std::ifstream& in, int* line_number) {
     Image image;
     image.image_id = tokens.Unsigned("image id", UINT32_MAX);
     for (int k = 0; k < 4; ++k) image.qvec(k) = tokens.Double("qvec");
@@ -139,12 +147,13 @@ void ReadImages(const std::string& path, Reconstruction* rec) {
     image.name = tokens.Next("image name");
     tokens.ExpectDone();
     // The 2D points are on the next line, which is empty for an image without any.
+    std::string line;
     if (!std::getline(in, line)) {
       tokens.Fail("missing the 2D points line of image " +
                   std::to_string(image.image_id));
     }
-    ++line_number;
-    LineTokens points(path, line_number, TrimLine(line));
+    ++*line_number;
+    LineTokens points(path, *line_number, TrimLine(line));
     if (points.size() % 3 != 0) {
       points.Fail("2D points need 3 values each (X, Y, POINT3D_ID), got " +
                   std::to_string(points.size()));
@@ -155,27 +164,15 @@ void ReadImages(const std::string& path, Reconstruction* rec) {
       p.xy.y() = points.Double("2D point y");
       p.point3D_id = points.Point3DId();
     }
-    try {
-      internal::CheckImage(image, path);
-    } catch (const Error& e) {
-      tokens.Fail(std::string(e.what()).substr(path.size() + 2));
-    }
+    CheckOnLine(tokens, path, [&] { internal::CheckImage(image, path); });
     if (!rec->images.emplace(image.image_id, std::move(image)).second) {
       tokens.Fail("duplicate image id");
     }
-  }
-  if (in.bad()) throw Error(path, "read failed");
+  });
 }
 
 void ReadPoints3D(const std::string& path, Reconstruction* rec) {
-  std::ifstream in = OpenText(path);
-  std::string line;
-  int line_number = 0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    line = TrimLine(line);
-    if (line.empty() || line[0] == '#') continue;
-    LineTokens tokens(path, line_number, line);
+  ForEachRecord(path, [&](LineTokens& tokens, std::ifstream&, int*) {
     const uint64_t id = tokens.Unsigned("point3D id", kInvalidPoint3DId - 1);
     Point3D point;
     for (int k = 0; k < 3; ++k) point.xyz(k) = tokens.Double("point3D position");
@@ -189,16 +186,11 @@ void ReadPoints3D(const std::string& path, Reconstruction* rec) {
       el.point2D_idx = tokens.Unsigned("track point2D index", UINT32_MAX);
       point.track.push_back(el);
     }
-    try {
-      internal::CheckPoint3D(id, point, path);
-    } catch (const Error& e) {
-      tokens.Fail(std::string(e.what()).substr(path.size() + 2));
-    }
+    CheckOnLine(tokens, path, [&] { internal::CheckPoint3D(id, point, path); });
     if (!rec->points3D.emplace(id, std::move(point)).second) {
       tokens.Fail("duplicate point3D id " + std::to_string(id));
     }
-  }
-  if (in.bad()) throw Error(path, "read failed");
+  });
 }
 
 // One line of output. Doubles are printed as printf("%.17g") (what COLMAP's streams with
