@@ -72,12 +72,18 @@ class FvsMethod : public Method {
   FvsMethod(FvsNet net, ModelConfig config, const RenderOptions& options)
       : net_(std::move(net)), config_(std::move(config)), options_(options) {
     net_->eval();
+    // Channels-last: oneDNN's convolutions run 15-25 % faster on it on this CPU (measured
+    // on the demo path, 480x360, K = 5: 3.0-3.3 s against 3.4-4.4 s per frame, noisy
+    // machine), and it is the layout CUDA's tensor cores want.
+    for (auto& p : net_->parameters()) {
+      if (p.dim() == 4) p.set_data(p.contiguous(torch::MemoryFormat::ChannelsLast));
+    }
   }
 
   std::string name() const override { return config_.variant; }
 
   RenderResult Render(const Scene& scene, const TargetView& target) override {
-    torch::NoGradGuard no_grad;
+    c10::InferenceMode inference;
     PreparedTarget prepared = PrepareTarget(scene, target, options_);
     RenderResult result;
     result.depth = std::move(prepared.depth);
@@ -116,7 +122,8 @@ class FvsMethod : public Method {
                                            warp_mask, config_, options_.num_threads);
     }
     const BlendOutput out =
-        net_->Blend(torch::cat(warped, 0), valid_depth, warp_mask, ulr_log_weights);
+        net_->Blend(torch::cat(warped, 0).contiguous(torch::MemoryFormat::ChannelsLast),
+                    valid_depth, warp_mask, ulr_log_weights);
     // [-1,1] -> [0,1]; the net clamps and removes NaN at inference.
     result.color = ToImage((out.rgb + 1.0) * 0.5);
     const torch::Tensor covered = (warp_mask.sum(0, true) > 0).to(torch::kFloat32);
@@ -142,7 +149,8 @@ class FvsMethod : public Method {
       return it->second;
     }
     Timer timer;
-    const torch::Tensor image = ToTensor(scene.SourceImage(view)) * 2.0 - 1.0;
+    const torch::Tensor image = (ToTensor(scene.SourceImage(view)) * 2.0 - 1.0)
+                                    .contiguous(torch::MemoryFormat::ChannelsLast);
     torch::Tensor features = net_->Encode(image);
     encode_seconds_ += timer.Seconds();
     while (static_cast<int>(cache_.size()) >= kMaxCachedSources && !order_.empty()) {
