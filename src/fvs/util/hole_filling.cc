@@ -123,7 +123,7 @@ void FillHoles(const Image& coverage, const Image* depth, Image* color) {
     return depth != nullptr && !(depth->data[i] > 0 && std::isfinite(depth->data[i]));
   };
   std::vector<double> weights(n, 0.0), far_weights(n, 0.0);
-  bool any_hole = false, any_far_hole = false;
+  bool any_near_hole = false, any_far_hole = false;
   for (size_t i = 0; i < n; ++i) {
     double w = coverage.data[i];
     w = std::isfinite(w) ? std::clamp(w, 0.0, 1.0) : 0.0;
@@ -132,17 +132,18 @@ void FillHoles(const Image& coverage, const Image* depth, Image* color) {
     }
     weights[i] = w;
     if (no_surface(i)) far_weights[i] = w;
-    any_hole = any_hole || w < 1.0;
-    any_far_hole = any_far_hole || (w < 1.0 && no_surface(i));
+    if (w < 1.0) (no_surface(i) ? any_far_hole : any_near_hole) = true;
   }
-  if (!any_hole) return;
-  const std::vector<double> all = PushPull(weights, *color);
-  if (all.empty()) return;  // nothing covered: left as it is
   // Holes without a surface (sky, background beyond the mesh) are filled from covered
   // pixels without a surface only, when there are any: a dark backdrop must not take the
-  // colour of the lit object in front of it.
+  // colour of the lit object in front of it. The pyramid of all covered pixels is built
+  // only when some hole needs it (outdoors the holes are usually all sky).
   const std::vector<double> far =
       any_far_hole ? PushPull(far_weights, *color) : std::vector<double>();
+  const bool need_all = any_near_hole || (any_far_hole && far.empty());
+  const std::vector<double> all =
+      need_all ? PushPull(weights, *color) : std::vector<double>();
+  if (far.empty() && all.empty()) return;  // no hole, or nothing covered: left as it is
   for (size_t i = 0; i < n; ++i) {
     if (weights[i] >= 1.0) continue;  // fully covered pixels keep their colour exactly
     const std::vector<double>& source = no_surface(i) && !far.empty() ? far : all;
