@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 
+#include "fvs/net/image_tensor.h"
 #include "fvs/net/net.h"
 #include "fvs/util/error.h"
 #include "fvs/util/safetensors.h"
@@ -105,10 +106,7 @@ class Lpips {
 
   std::vector<torch::Tensor> Features(const Image& image) {
     Require(image.channels == 3, "LPIPS", "needs RGB images");
-    torch::Tensor x = torch::from_blob(const_cast<float*>(image.data.data()),
-                                       {1, image.height, image.width, 3}, torch::kFloat32)
-                          .permute({0, 3, 1, 2})
-                          .contiguous();
+    torch::Tensor x = ImageToTensor(image);
     const torch::Tensor shift =
         torch::tensor({-.030f, -.088f, -.188f}).view({1, 3, 1, 1});
     const torch::Tensor scale = torch::tensor({.458f, .448f, .450f}).view({1, 3, 1, 1});

@@ -5,6 +5,7 @@
 #include <list>
 #include <map>
 
+#include "fvs/net/image_tensor.h"
 #include "fvs/net/net.h"
 #include "fvs/render/prepare.h"
 #include "fvs/render/ulr.h"
@@ -15,25 +16,6 @@
 
 namespace fvs {
 namespace {
-
-// [H,W,C] float image -> [1,C,H,W] tensor (a copy).
-torch::Tensor ToTensor(const Image& image) {
-  return torch::from_blob(const_cast<float*>(image.data.data()),
-                          {image.height, image.width, image.channels}, torch::kFloat32)
-      .permute({2, 0, 1})
-      .unsqueeze(0)
-      .contiguous();
-}
-
-Image ToImage(const torch::Tensor& chw) {
-  const torch::Tensor hwc =
-      chw.squeeze(0).permute({1, 2, 0}).contiguous().to(torch::kCPU);
-  Image image(static_cast<int>(hwc.size(1)), static_cast<int>(hwc.size(0)),
-              static_cast<int>(hwc.size(2)));
-  std::memcpy(image.data.data(), hwc.data_ptr<float>(),
-              image.data.size() * sizeof(float));
-  return image;
-}
 
 // The prior of ModelConfig::ulr_prior: ULR log-weights [K,1,H,W] of the prepared
 // sources, from the same surface points the `ulr` method blends at (`depth`: the
@@ -104,13 +86,14 @@ class FvsMethod : public Method {
       const Image grid =
           GridSampleCoordinates(prepared.warps[i], scene.view(view).camera.width,
                                 scene.view(view).camera.height);
-      const torch::Tensor grid_t = ToTensor(grid).permute({0, 2, 3, 1});  // [1,H,W,2]
+      const torch::Tensor grid_t =
+          ImageToTensor(grid).permute({0, 2, 3, 1});  // [1,H,W,2]
       warped.push_back(WarpFeatures(features, grid_t));
-      valid_warp.push_back(ToTensor(prepared.warps[i].valid_warp));
+      valid_warp.push_back(ImageToTensor(prepared.warps[i].valid_warp));
     }
     result.timings.encode_s = encode_seconds_;
     encode_seconds_ = 0;
-    torch::Tensor valid_depth = ToTensor(prepared.warps[0].valid_depth);
+    torch::Tensor valid_depth = ImageToTensor(prepared.warps[0].valid_depth);
     torch::Tensor warp_mask = torch::cat(valid_warp, 0);
     if (!config_.inf_depth) {
       // Without the "far away" convention a pixel with no surface has no valid warp.
@@ -125,12 +108,13 @@ class FvsMethod : public Method {
         net_->Blend(torch::cat(warped, 0).contiguous(torch::MemoryFormat::ChannelsLast),
                     valid_depth, warp_mask, ulr_log_weights);
     // [-1,1] -> [0,1]; the net clamps and removes NaN at inference.
-    result.color = ToImage((out.rgb + 1.0) * 0.5);
+    result.color = TensorToImage((out.rgb + 1.0) * 0.5);
     const torch::Tensor covered = (warp_mask.sum(0, true) > 0).to(torch::kFloat32);
-    result.coverage = ToImage(covered);
+    result.coverage = TensorToImage(covered);
     if (out.weights.defined() && out.weights.numel() > 0) {
       // How much of the blend comes from sources that really see the pixel.
-      result.confidence = ToImage((out.weights * warp_mask).sum(0, true).clamp(0.0, 1.0));
+      result.confidence =
+          TensorToImage((out.weights * warp_mask).sum(0, true).clamp(0.0, 1.0));
     } else {
       result.confidence = result.coverage;
     }
@@ -149,7 +133,7 @@ class FvsMethod : public Method {
       return it->second;
     }
     Timer timer;
-    const torch::Tensor image = (ToTensor(scene.SourceImage(view)) * 2.0 - 1.0)
+    const torch::Tensor image = (ImageToTensor(scene.SourceImage(view)) * 2.0 - 1.0)
                                     .contiguous(torch::MemoryFormat::ChannelsLast);
     torch::Tensor features = net_->Encode(image);
     encode_seconds_ += timer.Seconds();

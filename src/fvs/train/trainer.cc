@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
-#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +14,7 @@
 #include <sstream>
 #include <thread>
 
+#include "fvs/net/image_tensor.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
 #include "fvs/util/hole_filling.h"
@@ -88,23 +88,10 @@ DeviceSample ToDevice(const TrainingSample& s, const torch::Device& device) {
 // FillHoles on a [1,3,H,W] image in [0,1]; covered and surface are [1,1,H,W] (> 0 = yes).
 torch::Tensor FillHolesOf(const torch::Tensor& rgb, const torch::Tensor& covered,
                           const torch::Tensor& surface) {
-  const int64_t h = rgb.size(2), w = rgb.size(3);
-  auto to_image = [&](const torch::Tensor& t, int channels) {
-    const torch::Tensor hwc =
-        t.to(torch::kCPU, torch::kFloat).squeeze(0).permute({1, 2, 0}).contiguous();
-    Image image(static_cast<int>(w), static_cast<int>(h), channels);
-    std::memcpy(image.data.data(), hwc.data_ptr<float>(),
-                image.data.size() * sizeof(float));
-    return image;
-  };
-  Image color = to_image(rgb, 3);
-  const Image coverage = to_image(covered, 1), depth = to_image(surface, 1);
-  FillHoles(coverage, &depth, &color);
-  return torch::from_blob(color.data.data(), {h, w, 3}, torch::kFloat)
-      .permute({2, 0, 1})
-      .unsqueeze(0)
-      .clone()
-      .to(rgb.device());
+  Image color = TensorToImage(rgb);
+  const Image depth = TensorToImage(surface);
+  FillHoles(TensorToImage(covered), &depth, &color);
+  return ImageToTensor(color).to(rgb.device());
 }
 
 void SetUlrPrior(const ModelConfig& config, WarpSettings* warp) {
