@@ -10,7 +10,6 @@
 #include "fvs/render/prepare.h"
 #include "fvs/render/ulr.h"
 #include "fvs/scene/scene.h"
-#include "fvs/scene/warp.h"
 #include "fvs/util/error.h"
 #include "fvs/util/progress.h"
 
@@ -27,13 +26,11 @@ torch::Tensor UlrLogWeightTensor(const Scene& scene, const TargetView& target,
   const PinholeCamera& cam = target.camera;
   const int w = cam.width, h = cam.height;
   const int64_t num_pixels = static_cast<int64_t>(w) * h;
-  const WarpOptions warp_defaults;
   std::vector<double> points(3 * num_pixels);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
+      const Eigen::Vector3d p = UlrSurfacePoint(cam, depth, x, y);
       const int64_t i = static_cast<int64_t>(y) * w + x;
-      const double d = EffectiveDepth(depth.data[i], warp_defaults.invalid_depth);
-      const Eigen::Vector3d p = cam.PixelToCamera(x + 0.5, y + 0.5, d);
       for (int c = 0; c < 3; ++c) points[3 * i + c] = p[c];
     }
   }

@@ -39,7 +39,6 @@ class UlrMethod : public Method {
     UlrSettings settings;
     settings.resolution_weight = options_.ulr_resolution_weight;
     settings.num_blend = options_.ulr_num_blend;
-    const WarpOptions warp_defaults;
     result.color = Image(w, h, 3);
     result.confidence = Image(w, h, 1);
     result.coverage = Image(w, h, 1);
@@ -51,9 +50,7 @@ class UlrMethod : public Method {
           float sample[4];
           for (int x = 0; x < w; ++x) {
             const size_t i = static_cast<size_t>(y) * w + x;
-            const double d =
-                EffectiveDepth(prepared.depth.data[i], warp_defaults.invalid_depth);
-            const Eigen::Vector3d point = cam.PixelToCamera(x + 0.5, y + 0.5, d);
+            const Eigen::Vector3d point = UlrSurfacePoint(cam, prepared.depth, x, y);
             for (int s = 0; s < n; ++s)
               sees[s] = prepared.warps[s].valid_warp.data[i] > 0;
             const int m =
@@ -87,6 +84,13 @@ class UlrMethod : public Method {
 };
 
 }  // namespace
+
+Eigen::Vector3d UlrSurfacePoint(const PinholeCamera& target, const Image& depth, int x,
+                                int y) {
+  const double d = EffectiveDepth(depth.data[static_cast<size_t>(y) * depth.width + x],
+                                  WarpOptions().invalid_depth);
+  return target.PixelToCamera(x + 0.5, y + 0.5, d);
+}
 
 UlrSources MakeUlrSources(const Scene& scene, const TargetView& target,
                           const PreparedTarget& prepared) {

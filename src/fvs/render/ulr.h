@@ -16,6 +16,12 @@ struct PreparedTarget;
 class Scene;
 struct TargetView;
 
+// The surface point of target pixel (x, y) that ULR weighs the sources at, in the
+// target's camera frame: along the pixel centre's ray at the target depth, or at the
+// warp's invalid_depth ("far away") where the pixel has no surface.
+Eigen::Vector3d UlrSurfacePoint(const PinholeCamera& target, const Image& depth, int x,
+                                int y);
+
 // The selected sources of a prepared target as UlrSources (centres in the target frame).
 UlrSources MakeUlrSources(const Scene& scene, const TargetView& target,
                           const PreparedTarget& prepared);
