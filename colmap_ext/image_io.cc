@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 
 #include "fvs/util/atomic_file.h"
@@ -84,6 +85,19 @@ void ReadImageSize(const std::string& path, int* width, int* height) {
   *width = input->spec().width;
   *height = input->spec().height;
   input->close();
+}
+
+bool IsCompleteImage(const std::string& path, int width, int height) {
+  if (!std::filesystem::exists(path)) return false;
+  try {
+    int w = 0, h = 0;
+    ReadImageSize(path, &w, &h);
+    if (w != width || h != height) return false;
+    ReadImage(path);  // decodes: a truncated file fails here
+    return true;
+  } catch (const Error&) {
+    return false;
+  }
 }
 
 void WriteImage(const std::string& path, const fvs::Image& image, int bits) {

@@ -16,6 +16,9 @@ namespace fvs::colmap {
 fvs::Image ReadImage(const std::string& path, int channels = 3);
 // Size without decoding the pixels.
 void ReadImageSize(const std::string& path, int* width, int* height);
+// A finished output image: the file exists, has this size and decodes (a truncated file
+// does not). Never throws. Lets interrupted renders resume at the first missing image.
+bool IsCompleteImage(const std::string& path, int width, int height);
 // 8-bit PNG/JPEG by extension (values clamped to [0,1] and rounded), 16-bit when the
 // extension is .png and bits == 16; float for .exr/.tif with bits == 32. Atomic.
 void WriteImage(const std::string& path, const fvs::Image& image, int bits = 8);

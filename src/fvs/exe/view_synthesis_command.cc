@@ -87,20 +87,6 @@ struct ViewSynthesisOptions {
   }
 };
 
-// A finished frame: its PNG exists and has the size the target would have.
-bool FrameDone(const std::string& png, const PinholeCamera& camera) {
-  if (!std::filesystem::exists(png)) return false;
-  try {
-    int w = 0, h = 0;
-    colmap::ReadImageSize(png, &w, &h);
-    if (w != camera.width || h != camera.height) return false;
-    colmap::ReadImage(png);  // decodes: a truncated file fails here
-    return true;
-  } catch (const Error&) {
-    return false;
-  }
-}
-
 double CameraPathFps(const std::string& path) {
   try {
     std::ifstream in(path);
@@ -303,7 +289,8 @@ int RunViewSynthesis(int argc, char** argv) {
   for (const TargetCamera& t : targets) {
     cameras.push_back(ResizeTarget(t.camera, o.width, o.height, o.scale));
     done.push_back(!overwrite &&
-                   FrameDone(JoinPaths(o.output_path, t.name + ".png"), cameras.back()));
+                   colmap::IsCompleteImage(JoinPaths(o.output_path, t.name + ".png"),
+                                           cameras.back().width, cameras.back().height));
     to_render += !done.back();
   }
   if (to_render < static_cast<int64_t>(targets.size())) {

@@ -118,14 +118,7 @@ void RenderSyntheticFrames(
   Progress progress("Rendering ground-truth frames", static_cast<int64_t>(frames.size()));
   for (const auto& [name, camera] : frames) {
     const std::string path = output_dir + "/" + name + ".png";
-    int w = 0, h = 0;
-    bool done = false;
-    try {
-      colmap::ReadImageSize(path, &w, &h);
-      done = w == camera.width && h == camera.height;
-    } catch (const Error&) {
-    }
-    if (!done) {
+    if (!colmap::IsCompleteImage(path, camera.width, camera.height)) {
       Image color, depth, normals;
       RenderSyntheticView(scene, camera, &color, &depth, &normals);
       CheckFinite(color, path);

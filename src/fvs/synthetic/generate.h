@@ -26,7 +26,7 @@ void GenerateSyntheticScene(const SyntheticSceneOptions& options,
 // Ground truth for a camera path (e.g. a video rendered from the workspace above, whose
 // frame is the scene's): the scene the options make, rendered at every camera into
 // DIR/<name>.png. The cameras must lie in the scene's world frame. Frames already there
-// with the right size are kept (a killed run resumes).
+// complete (right size, decodable) are kept (a killed run resumes).
 void RenderSyntheticFrames(
     const SyntheticSceneOptions& options,
     const std::vector<std::pair<std::string, PinholeCamera>>& frames,
