@@ -201,6 +201,7 @@ class ViewSolver {
       }
     }
     for (int d = -r; d <= r; d += options_.window_step) offsets_.push_back(d);
+    window_samples_per_row_ = static_cast<int>(offsets_.size());
     num_samples_ = static_cast<int>(offsets_.size() * offsets_.size());
     // Bilateral weights (as COLMAP): spatial Gaussian per window sample, times a colour
     // Gaussian of the grey difference to the centre pixel, from a table.
@@ -312,10 +313,41 @@ class ViewSolver {
     return -ray.normalized();
   }
 
-  // Photometric cost 1 - NCC of the plane in every source, and (geometric pass) the
-  // forward-backward reprojection error. Returns the aggregated cost.
+  // The reference side of the weighted NCC of one pixel: the same for every source and
+  // every candidate plane, so built once per pixel visit.
+  struct Window {
+    float ref_mean, ref_std, inv_weight_sum;
+    float weights[kMaxWindowSamples * kMaxWindowSamples];
+    float weighted_ref[kMaxWindowSamples * kMaxWindowSamples];
+  };
+
+  void MakeWindow(int x, int y, Window* window) const {
+    const size_t i = Index(x, y);
+    window->ref_mean = ref_mean_[i];
+    window->ref_std = ref_std_[i];
+    window->inv_weight_sum = 1.0f / ref_weight_sum_[i];
+    WindowWeights(x, y, window->weights);
+    int k = 0;
+    for (int dy : offsets_) {
+      const float* row = RefRow(y + dy);
+      for (int dx : offsets_) {
+        window->weighted_ref[k] = window->weights[k] * row[x + dx];
+        ++k;
+      }
+    }
+  }
+
   float Cost(int x, int y, double depth, const Eigen::Vector3d& n, float* photo_costs,
              float* geo_errors) const {
+    Window window;
+    MakeWindow(x, y, &window);
+    return Cost(x, y, window, depth, n, photo_costs, geo_errors);
+  }
+
+  // Photometric cost 1 - NCC of the plane in every source, and (geometric pass) the
+  // forward-backward reprojection error. Returns the aggregated cost.
+  float Cost(int x, int y, const Window& window, double depth, const Eigen::Vector3d& n,
+             float* photo_costs, float* geo_errors) const {
     const Eigen::Vector3d ray = intr_.Ray(x, y);
     const Eigen::Vector3d X = depth * ray;
     const double plane_d = n.dot(X);
@@ -325,28 +357,14 @@ class ViewSolver {
                                               n.z() - n.x() * intr_.cx / intr_.fx -
                                                   n.y() * intr_.cy / intr_.fy) /
                               plane_d;
-    const size_t i = Index(x, y);
-    Window window;
-    window.ref_mean = ref_mean_[i];
-    window.ref_std = ref_std_[i];
-    window.inv_weight_sum = 1.0f / ref_weight_sum_[i];
-    WindowWeights(x, y, window.weights);
-    {
-      int k = 0;
-      for (int dy : offsets_) {
-        const float* row = RefRow(y + dy);
-        for (int dx : offsets_) {
-          window.weighted_ref[k] = window.weights[k] * row[x + dx];
-          ++k;
-        }
-      }
-    }
     float costs[64];
     const int num_sources = static_cast<int>(sources_.size());
     for (int s = 0; s < num_sources; ++s) {
       const Source& src = sources_[s];
       const Eigen::Matrix3d H = src.A + src.b * m.transpose();
-      float c = WindowCost(H, x, y, src, window);
+      float c = window_samples_per_row_ == 4   ? WindowCost<4>(H, x, y, src, window)
+                : window_samples_per_row_ == 7 ? WindowCost<7>(H, x, y, src, window)
+                                               : WindowCost<0>(H, x, y, src, window);
       if (photo_costs) photo_costs[s] = c;
       if (geometric_) {
         const double err = ReprojectionError(X, x, y, src);
@@ -364,14 +382,9 @@ class ViewSolver {
     return sum / top_k_;
   }
 
-  // The reference side of the weighted NCC of one pixel: the same for every source and
-  // every candidate plane.
-  struct Window {
-    float ref_mean, ref_std, inv_weight_sum;
-    float weights[kMaxWindowSamples * kMaxWindowSamples];
-    float weighted_ref[kMaxWindowSamples * kMaxWindowSamples];
-  };
-
+  // kN > 0: the window has kN samples per row (the defaults, radius 3 with step 2 or 1),
+  // known to the compiler so that it unrolls and vectorises the row loops.
+  template <int kN>
   float WindowCost(const Eigen::Matrix3d& Hd, int x, int y, const Source& src,
                    const Window& window) const {
     // The centre must land inside the source image, in front of it.
@@ -396,12 +409,13 @@ class ViewSolver {
     const float max_v = static_cast<float>(std::max(src.height - 2, 0)) + 0.999f;
     const int w = src.width;
     const float* img = src.grey;
-    const int n = static_cast<int>(offsets_.size());
+    const int n = kN > 0 ? kN : static_cast<int>(offsets_.size());
     float us[kMaxWindowSamples], vs[kMaxWindowSamples], samples[kMaxWindowSamples];
     float sum_s = 0, sum_ss = 0, sum_rs = 0;
     const float* weights = window.weights;
     const float* weighted_ref = window.weighted_ref;
-    for (int dy : offsets_) {
+    for (int row = 0; row < n; ++row) {
+      const int dy = offsets_[row];
       const float sx = static_cast<float>(x) + first, sy = static_cast<float>(y + dy);
       const float hx = H(0, 0) * sx + H(0, 1) * sy + H(0, 2);
       const float hy = H(1, 0) * sx + H(1, 1) * sy + H(1, 2);
@@ -468,9 +482,11 @@ class ViewSolver {
     const double us = src.intrinsics.fx * xs.x() / xs.z() + src.intrinsics.cx;
     const double vs = src.intrinsics.fy * xs.y() / xs.z() + src.intrinsics.cy;
     const Image& dm = *src.depth;
-    const int iu = static_cast<int>(std::lround(us)),
-              iv = static_cast<int>(std::lround(vs));
-    if (iu < 0 || iv < 0 || iu >= dm.width || iv >= dm.height) return max_err;
+    // Nearest pixel; written so that NaN fails too (and no lround of a huge value).
+    if (!(us > -0.5 && vs > -0.5 && us < dm.width - 0.5 && vs < dm.height - 0.5)) {
+      return max_err;
+    }
+    const int iu = static_cast<int>(us + 0.5), iv = static_cast<int>(vs + 0.5);
     const double ds = dm.data[static_cast<size_t>(iv) * dm.width + iu];
     if (!(ds > 0)) return max_err;
     const Eigen::Vector3d back_src = ds * src.intrinsics.Ray(us, vs);
@@ -478,7 +494,9 @@ class ViewSolver {
     if (!(back_ref.z() > 0)) return max_err;
     const double ur = intr_.fx * back_ref.x() / back_ref.z() + intr_.cx;
     const double vr = intr_.fy * back_ref.y() / back_ref.z() + intr_.cy;
-    const double err = std::hypot(ur - x, vr - y);
+    // Pixel-sized values: no overflow for hypot to guard against, at a fraction of its
+    // cost.
+    const double err = std::sqrt((ur - x) * (ur - x) + (vr - y) * (vr - y));
     return std::isfinite(err) ? err : max_err;
   }
 
@@ -512,6 +530,8 @@ class ViewSolver {
       const size_t i = Index(x, y);
       if (!textured_[i]) continue;
       const Eigen::Vector3d ray = intr_.Ray(x, y);
+      Window window;
+      MakeWindow(x, y, &window);
       double best_d = depth_[i];
       Eigen::Vector3d best_n = normal_[i];
       float best_c = cost_[i];
@@ -538,7 +558,7 @@ class ViewSolver {
           tried_d[num_tried] = d;
           tried_n[num_tried++] = n;
         }
-        const float c = Cost(x, y, d, n, nullptr, nullptr);
+        const float c = Cost(x, y, window, d, n, nullptr, nullptr);
         if (c < best_c) {
           best_c = c;
           best_d = d;
@@ -590,6 +610,7 @@ class ViewSolver {
   int pad_ = 0, padded_width_ = 0;
   std::vector<float> padded_ref_;
   std::vector<int> offsets_;
+  int window_samples_per_row_ = 0;
   int num_samples_ = 0;
   std::vector<float> ref_mean_, ref_std_, ref_weight_sum_;
   std::vector<float> spatial_weight_;  // per window sample, row by row
