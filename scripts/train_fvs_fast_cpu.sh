@@ -6,7 +6,7 @@
 # this again continues where the last run stopped. Niced: it soaks up idle CPU.
 #   scripts/train_fvs_fast_cpu.sh [DATASETS_DIR] [WORK_DIR]
 # Export weights from the newest checkpoint: rerun the trainer line with --Train.max_steps
-# set to the checkpoint's step (it writes WORK_DIR/runs/fvs_fast_ulr/model.safetensors).
+# set to the checkpoint's step (it writes WORK_DIR/runs/fvs_fast_w48/model.safetensors).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 DATASETS="$(realpath "${1:-../shared/datasets}")"
@@ -55,6 +55,6 @@ printf "packed/middlebury_temple\npacked/fox\n" > val.txt
 ls -d packed/* | grep -v -e middlebury_temple -e /fox > train.txt
 
 exec nice -n 19 env FVS_NUM_THREADS="$(nproc)" bin/colmap view_synthesis_train \
-  --scene_list train.txt --val_scene_list val.txt --output_path runs/fvs_fast_ulr \
+  --scene_list train.txt --val_scene_list val.txt --output_path runs/fvs_fast_w48 \
   --Train.variant fvs_fast --Train.crop 128 --Train.max_steps 200000 --Train.learning_rate 5e-4 \
   --Train.val_every 250 --Train.val_views 3 --Train.log_every 10 --Train.checkpoint_minutes 10

@@ -207,9 +207,8 @@ TEST(FvsNetTest, RgbSkipStartsAsThePriorBlendOfTheWarpedSources) {
   EXPECT_TRUE(
       torch::equal(encoded.narrow(1, net->config().feature_channels, 3), in.images));
   // Sources that do not see a pixel offer black there.
-  const torch::Tensor warped_rgb =
-      torch::where(in.valid_warp > 0.5, WarpFeatures(in.images, in.grid),
-                   torch::full({1}, -1.0f));
+  const torch::Tensor warped_rgb = torch::where(
+      in.valid_warp > 0.5, WarpFeatures(in.images, in.grid), torch::full({1}, -1.0f));
   const torch::Tensor w =
       torch::exp(mask_prior * (in.valid_warp - 1) + ulr_prior * in.ulr);
   const torch::Tensor expected =
@@ -393,7 +392,7 @@ TEST(FvsNetTest, TrainingGivesFiniteGradientsEverywhere) {
   EXPECT_EQ(net->named_parameters()["blend_d1_0.dw.weight"].sizes().vec(),
             std::vector<int64_t>({16, 1, 3, 3}));
   EXPECT_EQ(net->named_parameters()["blend_d1_0.pw.weight"].sizes().vec(),
-            std::vector<int64_t>({32, 16, 1, 1}));
+            std::vector<int64_t>({24, 16, 1, 1}));
   EXPECT_LT(net->BlendFlops(64, 64),
             FvsNet(ModelConfig::ForVariant("fvs_fast"))->BlendFlops(64, 64));
 }
