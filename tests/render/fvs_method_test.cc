@@ -118,6 +118,53 @@ TEST(FvsMethod, UntrainedFastNetworkRendersTheUlrBlend) {
   }
 }
 
+float MaxDifference(const Image& a, const Image& b) {
+  EXPECT_EQ(a.data.size(), b.data.size());
+  float worst = 0;
+  for (size_t i = 0; i < a.data.size() && i < b.data.size(); ++i) {
+    worst = std::max(worst, std::abs(a.data[i] - b.data[i]));
+  }
+  return worst;
+}
+
+// Tiles put each block of the blend where it belongs: with a context box as large as the
+// image every tile sees exactly what the whole target sees (a network with random,
+// context-dependent heads), and with no context at all a network whose output depends on
+// each pixel alone (untrained fvs_fast: the ULR blend) renders the same image too.
+TEST(FvsMethod, TiledBlendEqualsTheWholeTarget) {
+  testing::TempDir dir;
+  const Scene scene = testing::MakeTestScene(5, 32, 24);
+  const TargetView target = HeldOutTarget(scene, 2);
+  // fvs_nogru: context-dependent like fvs, at less than half its cost.
+  for (const char* variant : {"fvs_nogru", "fvs_fast"}) {
+    SCOPED_TRACE(variant);
+    const bool fvs = std::string(variant) == "fvs_nogru";
+    RenderOptions options;
+    options.num_sources = 3;
+    options.model_path = SaveRandomModel(dir.path(), variant);
+    options.tile_size = 0;
+    const RenderResult whole = CreateMethod("fvs", options)->Render(scene, target);
+    options.tile_size = fvs ? 16 : 11;  // 2 x 2 tiles; 3 x 3 tiles
+    options.tile_overlap = fvs ? 32 : 0;
+    std::unique_ptr<Method> tiled_method = CreateMethod("fvs", options);
+    const RenderResult tiled = tiled_method->Render(scene, target);
+    EXPECT_LT(MaxDifference(whole.color, tiled.color), 1e-5f);
+    EXPECT_LT(MaxDifference(whole.confidence, tiled.confidence), 1e-5f);
+    EXPECT_EQ(whole.coverage.data, tiled.coverage.data);
+    if (fvs) {
+      // A small context does change a context-dependent blend, but nothing non-finite
+      // comes out of the seams.
+      options.tile_overlap = 2;
+      const RenderResult seams = CreateMethod("fvs", options)->Render(scene, target);
+      EXPECT_TRUE(testing::AllFinite(seams.color));
+      EXPECT_GT(MaxDifference(whole.color, seams.color), 0.0f);
+    }
+  }
+  RenderOptions bad;
+  bad.tile_size = 3;
+  EXPECT_THROW(bad.Check(), Error);
+}
+
 TEST(FvsMethod, NoSourceSeesTheTargetGivesBlack) {
   testing::TempDir dir;
   const Scene scene = testing::MakeTestScene(3, 40, 32);

@@ -115,6 +115,11 @@ std::string RenderSettings(const ViewSynthesisOptions& o) {
   json["stable_source_order"] = o.render.stable_source_order;
   json["temporal_blend"] = o.temporal.temporal_blend;
   json["fill_holes"] = o.render.fill_holes;
+  // Tiles change the network's context at their seams.
+  if (o.method != "ulr" && o.method != "nearest") {
+    json["tile_size"] = o.render.tile_size;
+    json["tile_overlap"] = o.render.tile_overlap;
+  }
   json["targets"] = !o.target_images.empty() ? "target_images " + o.target_images
                     : !o.camera_path.empty() ? "camera_path " + o.camera_path
                     : o.orbit > 0            ? "orbit " + std::to_string(o.orbit)
@@ -202,6 +207,11 @@ int RunViewSynthesis(int argc, char** argv) {
   options.AddDefault("fill_holes", &o.render.fill_holes,
                      "fill pixels no source sees from the covered pixels around them "
                      "(0: leave them black; frame_report.csv counts them either way)");
+  options.AddDefault("tile_size", &o.render.tile_size,
+                     "--method fvs: blend targets larger than this in tiles of at most "
+                     "this size, to bound memory (0: never)");
+  options.AddDefault("tile_overlap", &o.render.tile_overlap,
+                     "--method fvs: pixels of context around each tile");
   options.AddDefault("num_threads", &o.render.num_threads, "threads (0: all cores)");
   options.AddDefault(
       "video", &o.video,

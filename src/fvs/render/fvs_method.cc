@@ -2,6 +2,7 @@
 
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <list>
 #include <map>
 
@@ -46,6 +47,38 @@ torch::Tensor UlrLogWeightTensor(const Scene& scene, const TargetView& target,
   return log_weights.reshape({k, 1, h, w});
 }
 
+// A block of the target, [y0, y1) x [x0, x1), and the larger box around it that the
+// network sees when blending it.
+struct Tile {
+  int y0, y1, x0, x1;
+  int cy0, cy1, cx0, cx1;
+};
+
+std::vector<Tile> Tiles(int width, int height, int tile_size, int overlap) {
+  if (tile_size <= 0 || (width <= tile_size && height <= tile_size)) {
+    return {Tile{0, height, 0, width, 0, height, 0, width}};
+  }
+  // Equal tiles rather than full ones and a sliver.
+  const int rows = (height + tile_size - 1) / tile_size;
+  const int cols = (width + tile_size - 1) / tile_size;
+  std::vector<Tile> tiles;
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      Tile t;
+      t.y0 = height * r / rows;
+      t.y1 = height * (r + 1) / rows;
+      t.x0 = width * c / cols;
+      t.x1 = width * (c + 1) / cols;
+      t.cy0 = std::max(0, t.y0 - overlap);
+      t.cy1 = std::min(height, t.y1 + overlap);
+      t.cx0 = std::max(0, t.x0 - overlap);
+      t.cx1 = std::min(width, t.x1 + overlap);
+      tiles.push_back(t);
+    }
+  }
+  return tiles;
+}
+
 class FvsMethod : public Method {
  public:
   FvsMethod(FvsNet net, ModelConfig config, const RenderOptions& options)
@@ -76,17 +109,16 @@ class FvsMethod : public Method {
     if (k == 0) return result;  // no source sees anything: black, coverage 0
 
     Timer timer;
-    std::vector<torch::Tensor> warped, valid_warp;
+    std::vector<const torch::Tensor*> features(k);
+    std::vector<torch::Tensor> grids(k), valid_warp(k);
     for (int i = 0; i < k; ++i) {
       const int view = prepared.sources[i].view_index;
-      const torch::Tensor& features = Features(scene, view);
+      features[i] = &Features(scene, view);
       const Image grid =
           GridSampleCoordinates(prepared.warps[i], scene.view(view).camera.width,
                                 scene.view(view).camera.height);
-      const torch::Tensor grid_t =
-          ImageToTensor(grid).permute({0, 2, 3, 1});  // [1,H,W,2]
-      warped.push_back(WarpFeatures(features, grid_t));
-      valid_warp.push_back(ImageToTensor(prepared.warps[i].valid_warp));
+      grids[i] = ImageToTensor(grid).permute({0, 2, 3, 1});  // [1,H,W,2]
+      valid_warp[i] = ImageToTensor(prepared.warps[i].valid_warp);
     }
     result.timings.encode_s = encode_seconds_;
     encode_seconds_ = 0;
@@ -101,20 +133,48 @@ class FvsMethod : public Method {
       ulr_log_weights = UlrLogWeightTensor(scene, target, prepared, result.depth,
                                            warp_mask, config_, options_.num_threads);
     }
-    const BlendOutput out =
-        net_->Blend(torch::cat(warped, 0).contiguous(torch::MemoryFormat::ChannelsLast),
-                    valid_depth, warp_mask, ulr_log_weights);
+    // [-1,1] RGB and the share of the blend from sources that see the pixel.
+    torch::Tensor rgb = torch::zeros({1, 3, h, w});
+    torch::Tensor seen_weight = torch::zeros({1, 1, h, w});
+    bool have_weights = false;
+    for (const Tile& tile : Tiles(w, h, options_.tile_size, options_.tile_overlap)) {
+      // Pixels [y0, y1) x [x0, x1) of the target, computed over the larger context box.
+      auto context = [&](const torch::Tensor& t) {  // [N,C,H,W]
+        return t.narrow(2, tile.cy0, tile.cy1 - tile.cy0)
+            .narrow(3, tile.cx0, tile.cx1 - tile.cx0);
+      };
+      auto core = [&](const torch::Tensor& t) {  // of a context-sized tensor
+        return t.narrow(2, tile.y0 - tile.cy0, tile.y1 - tile.y0)
+            .narrow(3, tile.x0 - tile.cx0, tile.x1 - tile.x0);
+      };
+      auto target_core = [&](const torch::Tensor& t) {
+        return t.narrow(2, tile.y0, tile.y1 - tile.y0)
+            .narrow(3, tile.x0, tile.x1 - tile.x0);
+      };
+      std::vector<torch::Tensor> warped(k);
+      for (int i = 0; i < k; ++i) {
+        const torch::Tensor grid = grids[i]
+                                       .narrow(1, tile.cy0, tile.cy1 - tile.cy0)
+                                       .narrow(2, tile.cx0, tile.cx1 - tile.cx0);
+        warped[i] = WarpFeatures(*features[i], grid);
+      }
+      const torch::Tensor tile_mask = context(warp_mask);
+      const BlendOutput out = net_->Blend(
+          torch::cat(warped, 0).contiguous(torch::MemoryFormat::ChannelsLast),
+          context(valid_depth), tile_mask,
+          ulr_log_weights.defined() ? context(ulr_log_weights) : ulr_log_weights);
+      target_core(rgb).copy_(core(out.rgb));
+      if (out.weights.defined() && out.weights.numel() > 0) {
+        have_weights = true;
+        target_core(seen_weight)
+            .copy_(core((out.weights * tile_mask).sum(0, true).clamp(0.0, 1.0)));
+      }
+    }
     // [-1,1] -> [0,1]; the net clamps and removes NaN at inference.
-    result.color = TensorToImage((out.rgb + 1.0) * 0.5);
+    result.color = TensorToImage((rgb + 1.0) * 0.5);
     const torch::Tensor covered = (warp_mask.sum(0, true) > 0).to(torch::kFloat32);
     result.coverage = TensorToImage(covered);
-    if (out.weights.defined() && out.weights.numel() > 0) {
-      // How much of the blend comes from sources that really see the pixel.
-      result.confidence =
-          TensorToImage((out.weights * warp_mask).sum(0, true).clamp(0.0, 1.0));
-    } else {
-      result.confidence = result.coverage;
-    }
+    result.confidence = have_weights ? TensorToImage(seen_weight) : result.coverage;
     result.timings.blend_s = timer.Seconds() - result.timings.encode_s;
     return result;
   }

@@ -25,6 +25,9 @@ void RenderOptions::Check() const {
   Require(ulr_num_blend >= 1, "ulr_num_blend", "must be at least 1");
   Require(source_hysteresis >= 0 && std::isfinite(source_hysteresis),
           "--source_hysteresis", "must be finite and non-negative");
+  Require(tile_size == 0 || tile_size >= 8, "--tile_size",
+          "must be 0 (off) or at least 8");
+  Require(tile_overlap >= 0, "--tile_overlap", "must be non-negative");
 }
 
 namespace {
