@@ -1,8 +1,11 @@
 // Render benchmark: time per frame with its split (target depth, source selection, warp,
 // blend) and the PSNR of the same frames against the exact ground truth, for `ulr` and
 // `nearest` at 480x270 and 960x540 with K = 1..8, on a generated scene (synthetic room,
-// exact mesh as the proxy). Held-out views are rendered from the other views.
+// exact mesh as the proxy), and for a network when given its weights (--model_path; the
+// encode column is the mean per frame, sources cached across the frames of one K).
+// Held-out views are rendered from the other views.
 //   render_benchmark [--views N] [--frames F] [--max_k K] [--sizes 480x270,960x540]
+//                    [--model_path weights.safetensors]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -23,12 +26,14 @@
 
 int main(int argc, char** argv) {
   int num_views = 16, num_frames = 3, max_k = 8;
+  std::string model_path;
   std::vector<std::pair<int, int>> sizes = {{480, 270}, {960, 540}};
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
     if (a == "--views") num_views = std::atoi(v.c_str());
     if (a == "--frames") num_frames = std::atoi(v.c_str());
     if (a == "--max_k") max_k = std::atoi(v.c_str());
+    if (a == "--model_path") model_path = v;
     if (a == "--sizes") {
       sizes.clear();
       size_t p = 0;
@@ -68,13 +73,17 @@ int main(int argc, char** argv) {
       for (int i = 0; i < num_views; ++i) scene.SetSourceImage(i, photos[i]);
       std::printf("\n%dx%d: scene built in %.2f s (source depths %.2f s)\n", width,
                   height, timer.Seconds(), scene.load_seconds());
-      std::printf("%-8s %2s %9s %9s %9s %9s %9s %9s %9s\n", "method", "K", "psnr_dB",
-                  "total_s", "depth_s", "select_s", "warp_s", "blend_s", "coverage");
-      for (const std::string method : {"nearest", "ulr"}) {
+      std::printf("%-8s %2s %9s %9s %9s %9s %9s %9s %9s %9s\n", "method", "K", "psnr_dB",
+                  "total_s", "depth_s", "select_s", "warp_s", "encode_s", "blend_s",
+                  "coverage");
+      std::vector<std::string> methods = {"nearest", "ulr"};
+      if (!model_path.empty()) methods.push_back("fvs");
+      for (const std::string& method : methods) {
         for (int k = 1; k <= max_k; ++k) {
           if (method == "nearest" && k > 1) break;  // uses the best source only
           fvs::RenderOptions render;
           render.num_sources = k;
+          render.model_path = model_path;
           auto renderer = fvs::CreateMethod(method, render);
           fvs::RenderTimings sum;
           double psnr = 0, coverage = 0;
@@ -95,11 +104,13 @@ int main(int argc, char** argv) {
             sum.depth_s += r.timings.depth_s / num_frames;
             sum.selection_s += r.timings.selection_s / num_frames;
             sum.warp_s += r.timings.warp_s / num_frames;
+            sum.encode_s += r.timings.encode_s / num_frames;
             sum.blend_s += r.timings.blend_s / num_frames;
           }
-          std::printf("%-8s %2d %9.2f %9.3f %9.3f %9.3f %9.3f %9.3f %8.1f%%\n",
-                      method.c_str(), k, psnr, sum.total(), sum.depth_s, sum.selection_s,
-                      sum.warp_s, sum.blend_s, 100 * coverage);
+          std::printf("%-8s %2d %9.2f %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f %8.1f%%\n",
+                      renderer->name().c_str(), k, psnr, sum.total(), sum.depth_s,
+                      sum.selection_s, sum.warp_s, sum.encode_s, sum.blend_s,
+                      100 * coverage);
           std::fflush(stdout);
         }
       }
