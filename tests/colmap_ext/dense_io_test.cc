@@ -17,22 +17,10 @@
 namespace fvs::colmap {
 namespace {
 
+using fvs::testing::ExpectError;
 using fvs::testing::ReadTextFile;
 using fvs::testing::TempDir;
 using fvs::testing::WriteTextFile;
-
-template <typename Fn>
-void ExpectError(Fn fn, const std::vector<std::string>& parts) {
-  try {
-    fn();
-    ADD_FAILURE() << "no error thrown";
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    for (const std::string& part : parts) {
-      EXPECT_NE(message.find(part), std::string::npos) << message << " lacks " << part;
-    }
-  }
-}
 
 std::string Float32LE(const std::vector<float>& values) {
   std::string bytes(values.size() * 4, '\0');

@@ -16,24 +16,10 @@
 namespace fvs::colmap {
 namespace {
 
+using fvs::testing::ExpectError;
 using fvs::testing::ReadTextFile;
 using fvs::testing::TempDir;
 using fvs::testing::WriteTextFile;
-
-// Runs fn, expects an fvs::Error whose message contains every one of `parts`.
-template <typename Fn>
-void ExpectError(Fn fn, const std::vector<std::string>& parts) {
-  try {
-    fn();
-    ADD_FAILURE() << "no error thrown";
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;
-    for (const std::string& part : parts) {
-      EXPECT_NE(message.find(part), std::string::npos) << message << " lacks " << part;
-    }
-  }
-}
 
 TEST(SparseIo, BinaryRoundTripIsExactAndStable) {
   TempDir dir;

@@ -175,7 +175,14 @@ TEST(Sweep, PlansEveryCombinationAndSkipsNetworksWithoutWeights) {
   o.num_sources = "0";
   EXPECT_THROW(PlanSweep(o), Error);
   o.num_sources = "1";
-  o.precisions = "fp16";
+  o.precisions = "fp8";
+  EXPECT_THROW(PlanSweep(o), Error);
+  // Other precisions are for the networks: the classical methods run once, in fp32.
+  o.precisions = "fp32,bf16";
+  const SweepPlan mixed = PlanSweep(o);
+  ASSERT_EQ(mixed.configs.size(), 2u + 2u);
+  for (const EvalConfig& c : mixed.configs) EXPECT_EQ(c.precision, "fp32");
+  o.precisions = "fp16";  // and nothing else to run
   EXPECT_THROW(PlanSweep(o), Error);
 }
 

@@ -165,6 +165,45 @@ TEST(FvsMethod, TiledBlendEqualsTheWholeTarget) {
   EXPECT_THROW(bad.Check(), Error);
 }
 
+// bf16 runs on the CPU (oneDNN) with warping and blend weights kept in fp32: the image
+// stays within a few 8-bit levels of fp32. fp16 needs CUDA, and so does --device cuda.
+TEST(FvsMethod, Bf16IsCloseToFp32AndFp16NeedsCuda) {
+  testing::TempDir dir;
+  const Scene scene = testing::MakeTestScene(5, 40, 30);
+  const TargetView target = HeldOutTarget(scene, 2);
+  for (const char* variant : {"fvs_fast", "fvs_nogru"}) {
+    SCOPED_TRACE(variant);
+    RenderOptions options;
+    options.num_sources = 3;
+    options.device = "cpu";
+    options.model_path = SaveRandomModel(dir.path(), variant);
+    const RenderResult fp32 = CreateMethod("fvs", options)->Render(scene, target);
+    options.precision = "bf16";
+    const RenderResult bf16 = CreateMethod("fvs", options)->Render(scene, target);
+    EXPECT_TRUE(testing::AllFinite(bf16.color));
+    EXPECT_TRUE(testing::AllFinite(bf16.confidence));
+    double sum = 0;
+    for (size_t i = 0; i < fp32.color.data.size(); ++i) {
+      sum += std::abs(fp32.color.data[i] - bf16.color.data[i]);
+    }
+    EXPECT_LT(sum / fp32.color.data.size(), 4.0 / 255);
+    EXPECT_LT(MaxDifference(fp32.color, bf16.color), 0.1f);
+    EXPECT_EQ(fp32.coverage.data, bf16.coverage.data);
+  }
+  RenderOptions options;
+  options.model_path = SaveRandomModel(dir.path(), "fvs_fast");
+  options.device = "cpu";
+  options.precision = "fp16";
+  EXPECT_THROW(CreateMethod("fvs", options), Error);
+  if (!torch::cuda::is_available()) {
+    options.precision = "fp32";
+    options.device = "cuda";
+    EXPECT_THROW(CreateMethod("fvs", options), Error);
+  }
+  options.precision = "fp8";
+  EXPECT_THROW(options.Check(), Error);
+}
+
 TEST(FvsMethod, NoSourceSeesTheTargetGivesBlack) {
   testing::TempDir dir;
   const Scene scene = testing::MakeTestScene(3, 40, 32);

@@ -1,7 +1,12 @@
 // Shared test helpers: temporary folders that clean up, paths of the build.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <string>
+#include <vector>
+
+#include "fvs/util/error.h"
 
 namespace fvs::testing {
 
@@ -30,5 +35,21 @@ int RunShell(const std::string& command, std::string* output = nullptr);
 
 void WriteTextFile(const std::string& path, const std::string& text);
 std::string ReadTextFile(const std::string& path);
+
+// Runs fn and expects an fvs::Error whose message is one line containing every one of
+// `parts` (the bad-input rule: one clear line naming the file and the fault).
+template <typename Fn>
+void ExpectError(Fn fn, const std::vector<std::string>& parts) {
+  try {
+    fn();
+    ADD_FAILURE() << "no error thrown";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;
+    for (const std::string& part : parts) {
+      EXPECT_NE(message.find(part), std::string::npos) << message << " lacks " << part;
+    }
+  }
+}
 
 }  // namespace fvs::testing

@@ -79,6 +79,7 @@ std::vector<ViewResult> EvaluateTargets(
   RenderOptions render = options.render;
   render.num_sources = config.num_sources;
   render.model_path = config.model_path;
+  render.precision = config.precision;
   std::unique_ptr<Method> method = CreateMethod(config.method, render);
 
   // Sources no target may use: the withheld set and photos that cannot be read.

@@ -67,8 +67,8 @@ void SweepOptions::Check() const {
   ParseIntList(num_sources, "--sweep_num_sources");
   ParseDoubleList(scales, "--sweep_scales");
   for (const std::string& p : Items(precisions)) {
-    Require(p == "fp32", "--sweep_precisions",
-            "'" + p + "': the CPU renderer computes in fp32 only");
+    Require(p == "fp32" || p == "bf16" || p == "fp16", "--sweep_precisions",
+            "'" + p + "': must be fp32, bf16 or fp16");
   }
 }
 
@@ -109,6 +109,8 @@ SweepPlan PlanSweep(const SweepOptions& options) {
       model_path = it->second;
     }
     for (const std::string& precision : Items(options.precisions)) {
+      // The classical methods compute in fp32 (double for geometry) only.
+      if (model_path.empty() && precision != "fp32") continue;
       for (double scale : scales) {
         for (int k : ks) {
           if (method == "nearest" && k != ks.front()) continue;

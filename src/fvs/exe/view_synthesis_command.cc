@@ -117,6 +117,7 @@ std::string RenderSettings(const ViewSynthesisOptions& o) {
   json["fill_holes"] = o.render.fill_holes;
   // Tiles change the network's context at their seams.
   if (o.method != "ulr" && o.method != "nearest") {
+    json["precision"] = o.render.precision;
     json["tile_size"] = o.render.tile_size;
     json["tile_overlap"] = o.render.tile_overlap;
   }
@@ -207,6 +208,10 @@ int RunViewSynthesis(int argc, char** argv) {
   options.AddDefault("fill_holes", &o.render.fill_holes,
                      "fill pixels no source sees from the covered pixels around them "
                      "(0: leave them black; frame_report.csv counts them either way)");
+  options.AddDefault("device", &o.render.device,
+                     "--method fvs: auto (CUDA when there is one), cpu or cuda");
+  options.AddDefault("precision", &o.render.precision,
+                     "--method fvs: fp32, bf16, or fp16 (CUDA only)");
   options.AddDefault("tile_size", &o.render.tile_size,
                      "--method fvs: blend targets larger than this in tiles of at most "
                      "this size, to bound memory (0: never)");

@@ -51,6 +51,7 @@ struct EvalCommandOptions {
   bool write_images = false;
   int num_threads = 0;
   bool fill_holes = true;
+  std::string device = "auto";
 
   void Check() const {
     protocol.Check();
@@ -119,8 +120,12 @@ int RunViewSynthesisEval(int argc, char** argv) {
   options.AddDefault("sweep_methods", &o.sweep_options.methods, "methods to sweep");
   options.AddDefault("sweep_num_sources", &o.sweep_options.num_sources, "K values");
   options.AddDefault("sweep_scales", &o.sweep_options.scales, "resolution scales");
+  options.AddDefault("precision", &o.config.precision,
+                     "network methods: fp32, bf16, or fp16 (CUDA only)");
+  options.AddDefault("device", &o.device, "network methods: auto, cpu or cuda");
   options.AddDefault("sweep_precisions", &o.sweep_options.precisions,
-                     "precisions (the CPU renderer has fp32)");
+                     "precisions of the network methods: fp32, bf16 (CPU or CUDA), fp16 "
+                     "(CUDA)");
   options.AddDefault("sweep_model_paths", &o.sweep_options.model_paths,
                      "weight files of network variants to sweep (comma-separated)");
   options.AddDefault("shard", &o.shard,
@@ -152,6 +157,8 @@ int RunViewSynthesisEval(int argc, char** argv) {
   EvalRunOptions run;
   run.render.num_threads = o.num_threads;
   run.render.fill_holes = o.fill_holes;
+  run.render.device = o.device;
+  run.render.Check();
   if (o.sweep) {
     SweepOptions sweep = o.sweep_options;
     if (!o.config.model_path.empty()) {
@@ -164,6 +171,8 @@ int RunViewSynthesisEval(int argc, char** argv) {
     RenderOptions render = run.render;
     render.num_sources = o.config.num_sources;
     render.model_path = o.config.model_path;
+    render.precision = o.config.precision;
+    render.Check();
     CreateMethod(o.config.method, render);  // throws for a method that cannot run
     configs.push_back(o.config);
   }

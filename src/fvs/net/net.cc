@@ -32,6 +32,11 @@ torch::Tensor PadTo(const torch::Tensor& x, int64_t stride, bool replicate) {
   // blending input (zero = "no source there", the same as an invalid warp).
   if (replicate) {
     options.mode(torch::kReplicate);
+    // LibTorch 1.13's CPU replication pad has no bf16/fp16 kernel: pad in fp32.
+    if (x.is_cpu() && x.scalar_type() != torch::kFloat32 &&
+        x.scalar_type() != torch::kFloat64) {
+      return F::pad(x.to(torch::kFloat32), options).to(x.scalar_type());
+    }
   } else {
     options.mode(torch::kConstant);
   }

@@ -81,9 +81,15 @@ std::vector<Tile> Tiles(int width, int height, int tile_size, int overlap) {
 
 class FvsMethod : public Method {
  public:
-  FvsMethod(FvsNet net, ModelConfig config, const RenderOptions& options)
-      : net_(std::move(net)), config_(std::move(config)), options_(options) {
+  FvsMethod(FvsNet net, ModelConfig config, const RenderOptions& options,
+            torch::Device device, torch::ScalarType dtype)
+      : net_(std::move(net)),
+        config_(std::move(config)),
+        options_(options),
+        device_(device),
+        dtype_(dtype) {
     net_->eval();
+    net_->to(device_, dtype_);
     // Channels-last: oneDNN's convolutions run 15-25 % faster on it on this CPU (measured
     // on the demo path, 480x360, K = 5: 3.0-3.3 s against 3.4-4.4 s per frame, noisy
     // machine), and it is the layout CUDA's tensor cores want.
@@ -117,12 +123,12 @@ class FvsMethod : public Method {
       const Image grid =
           GridSampleCoordinates(prepared.warps[i], scene.view(view).camera.width,
                                 scene.view(view).camera.height);
-      grids[i] = ImageToTensor(grid).permute({0, 2, 3, 1});  // [1,H,W,2]
-      valid_warp[i] = ImageToTensor(prepared.warps[i].valid_warp);
+      grids[i] = ImageToTensor(grid).permute({0, 2, 3, 1}).to(device_);  // [1,H,W,2]
+      valid_warp[i] = ImageToTensor(prepared.warps[i].valid_warp).to(device_);
     }
     result.timings.encode_s = encode_seconds_;
     encode_seconds_ = 0;
-    torch::Tensor valid_depth = ImageToTensor(prepared.warps[0].valid_depth);
+    torch::Tensor valid_depth = ImageToTensor(prepared.warps[0].valid_depth).to(device_);
     torch::Tensor warp_mask = torch::cat(valid_warp, 0);
     if (!config_.inf_depth) {
       // Without the "far away" convention a pixel with no surface has no valid warp.
@@ -131,11 +137,13 @@ class FvsMethod : public Method {
     torch::Tensor ulr_log_weights;
     if (config_.ulr_prior > 0) {
       ulr_log_weights = UlrLogWeightTensor(scene, target, prepared, result.depth,
-                                           warp_mask, config_, options_.num_threads);
+                                           warp_mask.cpu(), config_, options_.num_threads)
+                            .to(device_);
     }
     // [-1,1] RGB and the share of the blend from sources that see the pixel.
-    torch::Tensor rgb = torch::zeros({1, 3, h, w});
-    torch::Tensor seen_weight = torch::zeros({1, 1, h, w});
+    const auto fp32 = torch::TensorOptions().dtype(torch::kFloat32).device(device_);
+    torch::Tensor rgb = torch::zeros({1, 3, h, w}, fp32);
+    torch::Tensor seen_weight = torch::zeros({1, 1, h, w}, fp32);
     bool have_weights = false;
     for (const Tile& tile : Tiles(w, h, options_.tile_size, options_.tile_overlap)) {
       // Pixels [y0, y1) x [x0, x1) of the target, computed over the larger context box.
@@ -156,7 +164,10 @@ class FvsMethod : public Method {
         const torch::Tensor grid = grids[i]
                                        .narrow(1, tile.cy0, tile.cy1 - tile.cy0)
                                        .narrow(2, tile.cx0, tile.cx1 - tile.cx0);
-        warped[i] = WarpFeatures(*features[i], grid);
+        // Sampling positions need fp32 (bf16 would move them by pixels): warp in fp32.
+        warped[i] = dtype_ == torch::kFloat32
+                        ? WarpFeatures(*features[i], grid)
+                        : WarpFeatures(features[i]->to(torch::kFloat32), grid).to(dtype_);
       }
       const torch::Tensor tile_mask = context(warp_mask);
       const BlendOutput out = net_->Blend(
@@ -171,10 +182,10 @@ class FvsMethod : public Method {
       }
     }
     // [-1,1] -> [0,1]; the net clamps and removes NaN at inference.
-    result.color = TensorToImage((rgb + 1.0) * 0.5);
-    const torch::Tensor covered = (warp_mask.sum(0, true) > 0).to(torch::kFloat32);
+    result.color = TensorToImage(((rgb + 1.0) * 0.5).cpu());
+    const torch::Tensor covered = (warp_mask.sum(0, true) > 0).to(torch::kFloat32).cpu();
     result.coverage = TensorToImage(covered);
-    result.confidence = have_weights ? TensorToImage(seen_weight) : result.coverage;
+    result.confidence = have_weights ? TensorToImage(seen_weight.cpu()) : result.coverage;
     result.timings.blend_s = timer.Seconds() - result.timings.encode_s;
     return result;
   }
@@ -191,6 +202,7 @@ class FvsMethod : public Method {
     }
     Timer timer;
     const torch::Tensor image = (ImageToTensor(scene.SourceImage(view)) * 2.0 - 1.0)
+                                    .to(device_, dtype_)
                                     .contiguous(torch::MemoryFormat::ChannelsLast);
     torch::Tensor features = net_->Encode(image);
     encode_seconds_ += timer.Seconds();
@@ -208,6 +220,8 @@ class FvsMethod : public Method {
   FvsNet net_;
   ModelConfig config_;
   RenderOptions options_;
+  torch::Device device_;
+  torch::ScalarType dtype_;
   std::map<int, torch::Tensor> cache_;
   std::list<int> order_;
   double encode_seconds_ = 0;
@@ -223,13 +237,30 @@ std::unique_ptr<Method> CreateFvsMethod(const std::string& requested,
                     " needs model weights: --model_path <weights.safetensors>");
   }
   ConfigureTorchThreads();
+  const bool have_cuda = torch::cuda::is_available();
+  if (options.device == "cuda" && !have_cuda) {
+    throw Error("--device cuda",
+                "no CUDA device: this build's LibTorch has no CUDA or the "
+                "machine has no GPU (use --device cpu or auto)");
+  }
+  const torch::Device device(options.device == "cpu" || !have_cuda ? torch::kCPU
+                                                                   : torch::kCUDA);
+  if (options.precision == "fp16" && device.is_cpu()) {
+    throw Error("--precision fp16",
+                "fp16 needs a CUDA device (LibTorch's CPU convolutions have no fp16; "
+                "bf16 runs on the CPU)");
+  }
+  const torch::ScalarType dtype = options.precision == "bf16"   ? torch::kBFloat16
+                                  : options.precision == "fp16" ? torch::kHalf
+                                                                : torch::kFloat32;
   ModelConfig config;
   FvsNet net = LoadModel(options.model_path, &config);
   if (requested != "fvs" && requested != config.variant) {
     throw Error(options.model_path, "weights are of variant '" + config.variant +
                                         "', not '" + requested + "'");
   }
-  return std::make_unique<FvsMethod>(std::move(net), std::move(config), options);
+  return std::make_unique<FvsMethod>(std::move(net), std::move(config), options, device,
+                                     dtype);
 }
 
 }  // namespace fvs

@@ -56,6 +56,12 @@ struct RenderOptions {
   // tile, not of the target). Also faster on a CPU (cache): fvs_fast at 1920x1080, K = 5,
   // 2 cores: untiled 41 s per frame and 7.5 GB, tiles of 1024 34 s and 3.1 GB, of 512
   // 27 s and 2.4 GB. 0 = never tile.
+  // Network methods: where and in what precision the network runs. device: auto (CUDA
+  // when this build and machine have it, else the CPU), cpu or cuda. precision: fp32,
+  // bf16 or fp16 (fp16 on CUDA only: LibTorch's CPU convolutions have none). Warping
+  // (sampling positions) and the softmax blend weights stay in fp32 whatever the choice.
+  std::string device = "auto";
+  std::string precision = "fp32";
   int tile_size = 512;
   int tile_overlap = 32;
   void Check() const;
