@@ -64,6 +64,16 @@ TEST(FvsMethod, FiniteDeterministicAndCached) {
   const RenderResult b = method->Render(scene, target);
   EXPECT_EQ(a.color.data, b.color.data);
   EXPECT_EQ(b.timings.encode_s, 0.0);
+
+  // No cache at all (every source dropped while the frame still uses it): the same image,
+  // every source encoded again.
+  options.feature_cache_mb = 0;
+  std::unique_ptr<Method> uncached = CreateMethod("fvs", options);
+  for (int round = 0; round < 2; ++round) {
+    const RenderResult c = uncached->Render(scene, target);
+    EXPECT_EQ(a.color.data, c.color.data);
+    EXPECT_GT(c.timings.encode_s, 0.0);
+  }
 }
 
 TEST(FvsMethod, EveryVariantRendersFiniteImages) {

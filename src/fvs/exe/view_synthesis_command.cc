@@ -212,6 +212,9 @@ int RunViewSynthesis(int argc, char** argv) {
                      "--method fvs: auto (CUDA when there is one), cpu or cuda");
   options.AddDefault("precision", &o.render.precision,
                      "--method fvs: fp32, bf16, or fp16 (CUDA only)");
+  options.AddDefault("feature_cache_mb", &o.render.feature_cache_mb,
+                     "--method fvs: memory for encoded source features kept across "
+                     "targets (0: none)");
   options.AddDefault("tile_size", &o.render.tile_size,
                      "--method fvs: blend targets larger than this in tiles of at most "
                      "this size, to bound memory (0: never)");

@@ -115,11 +115,13 @@ class FvsMethod : public Method {
     if (k == 0) return result;  // no source sees anything: black, coverage 0
 
     Timer timer;
-    std::vector<const torch::Tensor*> features(k);
+    // Held by value (a reference-counted handle): the cache may drop a source while this
+    // frame still uses it.
+    std::vector<torch::Tensor> features(k);
     std::vector<torch::Tensor> grids(k), valid_warp(k);
     for (int i = 0; i < k; ++i) {
       const int view = prepared.sources[i].view_index;
-      features[i] = &Features(scene, view);
+      features[i] = Features(scene, view);
       const Image grid =
           GridSampleCoordinates(prepared.warps[i], scene.view(view).camera.width,
                                 scene.view(view).camera.height);
@@ -166,8 +168,8 @@ class FvsMethod : public Method {
                                        .narrow(2, tile.cx0, tile.cx1 - tile.cx0);
         // Sampling positions need fp32 (bf16 would move them by pixels): warp in fp32.
         warped[i] = dtype_ == torch::kFloat32
-                        ? WarpFeatures(*features[i], grid)
-                        : WarpFeatures(features[i]->to(torch::kFloat32), grid).to(dtype_);
+                        ? WarpFeatures(features[i], grid)
+                        : WarpFeatures(features[i].to(torch::kFloat32), grid).to(dtype_);
       }
       const torch::Tensor tile_mask = context(warp_mask);
       const BlendOutput out = net_->Blend(
@@ -191,9 +193,9 @@ class FvsMethod : public Method {
   }
 
  private:
-  // Encoded features of a source view, cached (least recently used out first) so a path
-  // of targets encodes each source once.
-  const torch::Tensor& Features(const Scene& scene, int view) {
+  // Encoded features of a source view, cached (least recently used out first, within
+  // RenderOptions::feature_cache_mb) so a path of targets encodes each source once.
+  torch::Tensor Features(const Scene& scene, int view) {
     const auto it = cache_.find(view);
     if (it != cache_.end()) {
       order_.remove(view);
@@ -206,16 +208,21 @@ class FvsMethod : public Method {
                                     .contiguous(torch::MemoryFormat::ChannelsLast);
     torch::Tensor features = net_->Encode(image);
     encode_seconds_ += timer.Seconds();
-    while (static_cast<int>(cache_.size()) >= kMaxCachedSources && !order_.empty()) {
-      cache_.erase(order_.back());
+    const int64_t bytes = features.numel() * features.element_size();
+    const int64_t budget = static_cast<int64_t>(options_.feature_cache_mb) << 20;
+    while (!order_.empty() && cache_bytes_ + bytes > budget) {
+      const auto old = cache_.find(order_.back());
+      cache_bytes_ -= old->second.numel() * old->second.element_size();
+      cache_.erase(old);
       order_.pop_back();
     }
-    order_.push_front(view);
-    return cache_.emplace(view, std::move(features)).first->second;
+    if (bytes <= budget) {
+      order_.push_front(view);
+      cache_bytes_ += bytes;
+      cache_.emplace(view, features);
+    }
+    return features;
   }
-
-  // 64 channels x 640 x 480 x 4 bytes = 79 MB a source: 24 keep memory near 2 GB.
-  static constexpr int kMaxCachedSources = 24;
 
   FvsNet net_;
   ModelConfig config_;
@@ -224,6 +231,7 @@ class FvsMethod : public Method {
   torch::ScalarType dtype_;
   std::map<int, torch::Tensor> cache_;
   std::list<int> order_;
+  int64_t cache_bytes_ = 0;
   double encode_seconds_ = 0;
 };
 

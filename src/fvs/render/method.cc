@@ -28,6 +28,7 @@ void RenderOptions::Check() const {
   Require(tile_size == 0 || tile_size >= 8, "--tile_size",
           "must be 0 (off) or at least 8");
   Require(tile_overlap >= 0, "--tile_overlap", "must be non-negative");
+  Require(feature_cache_mb >= 0, "--feature_cache_mb", "must be non-negative");
   Require(device == "auto" || device == "cpu" || device == "cuda", "--device",
           "'" + device + "': must be auto, cpu or cuda");
   Require(precision == "fp32" || precision == "bf16" || precision == "fp16",
