@@ -142,6 +142,8 @@ class FvsMethod : public Method {
                                            warp_mask.cpu(), config_, options_.num_threads)
                             .to(device_);
     }
+    // Sampling positions need fp32 (bf16 would move them by pixels): warp in fp32.
+    for (torch::Tensor& f : features) f = f.to(torch::kFloat32);
     // [-1,1] RGB and the share of the blend from sources that see the pixel.
     const auto fp32 = torch::TensorOptions().dtype(torch::kFloat32).device(device_);
     torch::Tensor rgb = torch::zeros({1, 3, h, w}, fp32);
@@ -166,10 +168,7 @@ class FvsMethod : public Method {
         const torch::Tensor grid = grids[i]
                                        .narrow(1, tile.cy0, tile.cy1 - tile.cy0)
                                        .narrow(2, tile.cx0, tile.cx1 - tile.cx0);
-        // Sampling positions need fp32 (bf16 would move them by pixels): warp in fp32.
-        warped[i] = dtype_ == torch::kFloat32
-                        ? WarpFeatures(features[i], grid)
-                        : WarpFeatures(features[i].to(torch::kFloat32), grid).to(dtype_);
+        warped[i] = WarpFeatures(features[i], grid).to(dtype_);
       }
       const torch::Tensor tile_mask = context(warp_mask);
       const BlendOutput out = net_->Blend(
