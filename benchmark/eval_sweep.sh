@@ -6,6 +6,7 @@
 #   benchmark/eval_sweep.sh                  # both scenes
 #   FVS_BUILD_DIR=build-train benchmark/eval_sweep.sh
 #   FVS_EVAL_MODELS=a.safetensors,b.safetensors benchmark/eval_sweep.sh   # + network variants
+#   FVS_EVAL_PRECISIONS=fp32,bf16 ...        # + the networks in bf16
 #
 # Needs: the demo workspace (scripts/demo.sh makes demo_output/workspace); for the real
 # scene the photos at $FVS_DATASETS/sceaux_castle/images (prepared here into
@@ -20,6 +21,7 @@ DATASETS="${FVS_DATASETS:-../shared/datasets}"
 MODELS="${FVS_EVAL_MODELS:-$(ls models/*.safetensors 2>/dev/null | paste -sd, || true)}"
 SCALES="${FVS_EVAL_SCALES:-1,0.5,0.25}"
 KS="${FVS_EVAL_KS:-1,2,3,4,5,6,7,8}"
+PRECISIONS="${FVS_EVAL_PRECISIONS:-fp32}"  # fp32,bf16 (CPU or CUDA), fp16 (CUDA)
 export QT_QPA_PLATFORM=offscreen
 mkdir -p "$OUT" "$WORK"
 
@@ -29,6 +31,7 @@ sweep() {  # sweep NAME WORKSPACE PROTOCOL_ARGS...
   echo "== $name: $ws"
   "$COLMAP" view_synthesis_eval --workspace_path "$ws" --output_path "$OUT/$name" "$@" \
     --sweep 1 --sweep_num_sources "$KS" --sweep_scales "$SCALES" \
+    --sweep_precisions "$PRECISIONS" \
     ${MODELS:+--sweep_model_paths "$MODELS"} --method ulr --num_sources 5
 }
 
