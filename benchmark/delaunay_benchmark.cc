@@ -13,6 +13,7 @@
 #include <string>
 #include <thread>
 
+#include "benchmark/benchmark_args.h"
 #include "fvs/mvs/delaunay.h"
 #include "fvs/util/machine.h"
 #ifdef FVS_HAVE_CGAL
@@ -34,6 +35,11 @@ std::string LoadAverage() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  fvs::benchmark::CheckArgs(
+      argc, argv,
+      "usage: delaunay_benchmark [--points N] [--cameras K] [--noise S] [--outliers F] "
+      "[--max_proj_dist PX] [--threads T]",
+      {"--cameras", "--max_proj_dist", "--noise", "--outliers", "--points", "--threads"});
 #ifndef FVS_HAVE_CGAL
   std::fprintf(stderr,
                "built without CGAL or Boost.Graph: no Delaunay mesher to benchmark\n");

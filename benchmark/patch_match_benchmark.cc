@@ -23,6 +23,7 @@
 #include <string>
 #include <thread>
 
+#include "benchmark/benchmark_args.h"
 #include "colmap_ext/dense_io.h"
 #include "colmap_ext/image_io.h"
 #include "colmap_ext/sparse_io.h"
@@ -45,6 +46,17 @@ double LoadAverage() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  fvs::benchmark::CheckArgs(
+      argc, argv,
+      "usage: patch_match_benchmark [--views N] [--width W] [--height H] [--threads T] "
+      "[--scene synthetic|analytic] [--keep DIR] [--reuse 1] [--window_radius R] "
+      "[--window_step S] [--top_k K] [--iterations N] [--geom_iterations N] "
+      "[--fine_iterations N] [--coarse_levels N] [--min_consistent N] [--sigma_color C] "
+      "[--sources N] [--filter_angle DEGREES] [--fast_refinement 0|1]",
+      {"--coarse_levels", "--fast_refinement", "--filter_angle", "--fine_iterations",
+       "--geom_iterations", "--height", "--iterations", "--keep", "--min_consistent",
+       "--reuse", "--scene", "--sigma_color", "--sources", "--threads", "--top_k",
+       "--views", "--width", "--window_radius", "--window_step"});
   int views = 6, width = 800, height = 600, threads = 2;
   std::string scene_kind = "synthetic", keep;
   bool reuse = false;

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "benchmark/benchmark_args.h"
 #include "fvs/geometry/look_at.h"
 #include "fvs/geometry/ply.h"
 #include "fvs/geometry/rasterizer.h"
@@ -134,6 +135,10 @@ double Median(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  fvs::benchmark::CheckArgs(
+      argc, argv,
+      "usage: rasterizer_benchmark [--views N] [--runs R] [--check_rows K] [--threads T]",
+      {"--check_rows", "--runs", "--threads", "--views"});
   int views = 8, runs = 5, check_rows = 60, threads = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i];

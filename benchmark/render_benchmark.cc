@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "benchmark/benchmark_args.h"
 #include "fvs/eval/metrics.h"
 #include "fvs/render/method.h"
 #include "fvs/scene/scene.h"
@@ -25,6 +26,11 @@
 #include "fvs/util/progress.h"
 
 int main(int argc, char** argv) {
+  fvs::benchmark::CheckArgs(
+      argc, argv,
+      "usage: render_benchmark [--views N] [--frames F] [--max_k K] [--sizes "
+      "480x270,960x540] [--model_path weights.safetensors]",
+      {"--frames", "--max_k", "--model_path", "--sizes", "--views"});
   int num_views = 16, num_frames = 3, max_k = 8;
   std::string model_path;
   std::vector<std::pair<int, int>> sizes = {{480, 270}, {960, 540}};
