@@ -42,6 +42,27 @@ TEST(Stability, EveryCaseIsFiniteAndTranslationInvariant) {
   }
 }
 
+// The network's reduced-precision and tiled paths face the same extremes.
+TEST(Stability, Bf16AndTilesStayFiniteAndTranslationInvariant) {
+  testing::TempDir dir;
+  torch::manual_seed(3);
+  const ModelConfig config = ModelConfig::ForVariant("fvs_fast");
+  FvsNet net(config);
+  StabilityOptions options;
+  options.model_path = dir / "fvs_fast.safetensors";
+  SaveWeights(net, config, options.model_path, /*fp16=*/false);
+  options.methods = {"fvs_fast"};
+  options.precision = "bf16";
+  options.tile_size = 16;  // 3 x 2 tiles of 40x30
+  options.width = 40;
+  options.height = 30;
+  for (const StabilityResult& r : RunStabilitySuite(options)) {
+    EXPECT_TRUE(r.error.empty()) << r.case_name << ": " << r.error;
+    EXPECT_EQ(r.nan_count + r.inf_count, 0) << r.case_name;
+    EXPECT_LE(r.max_deviation, 1.0 / 255) << r.case_name;
+  }
+}
+
 TEST(Stability, CommandPrintsTheTable) {
   testing::TempDir dir;
   std::string output;

@@ -139,7 +139,10 @@ std::vector<StabilityResult> RunStabilitySuite(const StabilityOptions& options) 
         RenderOptions render;
         render.num_sources = c.k;
         render.model_path = options.model_path;
+        render.precision = options.precision;
+        render.tile_size = options.tile_size;
         render.num_threads = options.num_threads;
+        render.Check();
         Timer timer;
         // A fresh method per placement: nothing cached from one scene is reused.
         TargetView near_view, far_view;

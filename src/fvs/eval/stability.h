@@ -22,7 +22,9 @@ namespace fvs::eval {
 
 struct StabilityOptions {
   std::vector<std::string> methods = {"nearest", "ulr"};
-  std::string model_path;  // for network methods (random weights are fine here)
+  std::string model_path;          // for network methods (random weights are fine here)
+  std::string precision = "fp32";  // of network methods (RenderOptions::precision)
+  int tile_size = 512;             // of network methods (RenderOptions::tile_size)
   int width = 64, height = 48;
   double far_offset_m = 10000.0;  // distance of the far copy from the origin
   int num_threads = 0;

@@ -36,6 +36,10 @@ int RunViewSynthesisStability(int argc, char** argv) {
                      "comma-separated methods (network variants need --model_path; "
                      "random weights are fine for this suite)");
   options.AddDefault("model_path", &o.model_path, "network weights");
+  options.AddDefault("precision", &o.precision,
+                     "network methods: fp32, bf16, or fp16 (CUDA only)");
+  options.AddDefault("tile_size", &o.tile_size,
+                     "network methods: blend in tiles of at most this size (0: never)");
   options.AddDefault("width", &o.width, "target and source width");
   options.AddDefault("height", &o.height, "target and source height");
   options.AddDefault("far_offset", &o.far_offset_m, "distance of the far copy (m)");
