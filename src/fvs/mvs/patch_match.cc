@@ -201,7 +201,6 @@ class ViewSolver {
       }
     }
     for (int d = -r; d <= r; d += options_.window_step) offsets_.push_back(d);
-    window_samples_per_row_ = static_cast<int>(offsets_.size());
     num_samples_ = static_cast<int>(offsets_.size() * offsets_.size());
     // Bilateral weights (as COLMAP): spatial Gaussian per window sample, times a colour
     // Gaussian of the grey difference to the centre pixel, from a table.
@@ -362,9 +361,10 @@ class ViewSolver {
     for (int s = 0; s < num_sources; ++s) {
       const Source& src = sources_[s];
       const Eigen::Matrix3d H = src.A + src.b * m.transpose();
-      float c = window_samples_per_row_ == 4   ? WindowCost<4>(H, x, y, src, window)
-                : window_samples_per_row_ == 7 ? WindowCost<7>(H, x, y, src, window)
-                                               : WindowCost<0>(H, x, y, src, window);
+      const size_t per_row = offsets_.size();
+      float c = per_row == 4   ? WindowCost<4>(H, x, y, src, window)
+                : per_row == 7 ? WindowCost<7>(H, x, y, src, window)
+                               : WindowCost<0>(H, x, y, src, window);
       if (photo_costs) photo_costs[s] = c;
       if (geometric_) {
         const double err = ReprojectionError(X, x, y, src);
@@ -610,7 +610,6 @@ class ViewSolver {
   int pad_ = 0, padded_width_ = 0;
   std::vector<float> padded_ref_;
   std::vector<int> offsets_;
-  int window_samples_per_row_ = 0;
   int num_samples_ = 0;
   std::vector<float> ref_mean_, ref_std_, ref_weight_sum_;
   std::vector<float> spatial_weight_;  // per window sample, row by row
