@@ -67,7 +67,7 @@ void SweepOptions::Check() const {
   ParseIntList(num_sources, "--sweep_num_sources");
   ParseDoubleList(scales, "--sweep_scales");
   for (const std::string& p : Items(precisions)) {
-    Require(p == "fp32" || p == "bf16" || p == "fp16", "--sweep_precisions",
+    Require(KnownPrecision(p), "--sweep_precisions",
             "'" + p + "': must be fp32, bf16 or fp16");
   }
 }

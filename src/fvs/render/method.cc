@@ -13,6 +13,10 @@
 
 namespace fvs {
 
+bool KnownPrecision(const std::string& name) {
+  return name == "fp32" || name == "bf16" || name == "fp16";
+}
+
 void RenderOptions::Check() const {
   Require(num_sources >= 1, "--num_sources", "must be at least 1");
   Require(selection_tolerance > 0 && std::isfinite(selection_tolerance),
@@ -31,8 +35,8 @@ void RenderOptions::Check() const {
   Require(feature_cache_mb >= 0, "--feature_cache_mb", "must be non-negative");
   Require(device == "auto" || device == "cpu" || device == "cuda", "--device",
           "'" + device + "': must be auto, cpu or cuda");
-  Require(precision == "fp32" || precision == "bf16" || precision == "fp16",
-          "--precision", "'" + precision + "': must be fp32, bf16 or fp16");
+  Require(KnownPrecision(precision), "--precision",
+          "'" + precision + "': must be fp32, bf16 or fp16");
 }
 
 namespace {

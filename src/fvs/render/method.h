@@ -29,6 +29,10 @@ struct TargetView {
   std::vector<int> preferred_sources;
 };
 
+// The precisions a network method can run in (RenderOptions::precision): fp32, bf16,
+// fp16.
+bool KnownPrecision(const std::string& name);
+
 struct RenderOptions {
   int num_sources = 5;                // K
   double selection_tolerance = 0.10;  // relative depth tolerance for ranking sources
@@ -49,13 +53,6 @@ struct RenderOptions {
   // Pixels no source sees get colours pushed and pulled from the covered pixels around
   // them (render/hole_filling.h) instead of black; coverage and confidence stay 0 there.
   bool fill_holes = true;
-  // Network methods: a target wider or taller than tile_size pixels is blended in tiles
-  // of at most tile_size x tile_size, each computed with tile_overlap more pixels of
-  // context on every side and cropped, so that memory stays bounded for any target size
-  // (the blending U-Net's activations and the warped features scale with the pixels of a
-  // tile, not of the target). Also faster on a CPU (cache): fvs_fast at 1920x1080, K = 5,
-  // 2 cores: untiled 41 s per frame and 7.5 GB, tiles of 1024 34 s and 3.1 GB, of 512
-  // 27 s and 2.4 GB. 0 = never tile.
   // Network methods: where and in what precision the network runs. device: auto (CUDA
   // when this build and machine have it, else the CPU), cpu or cuda. precision: fp32,
   // bf16 or fp16 (fp16 on CUDA only: LibTorch's CPU convolutions have none). Warping
@@ -66,6 +63,13 @@ struct RenderOptions {
   // path encodes each source once). 64 channels of a 640x480 photo take 79 MB, of a
   // 1920x1080 one 530 MB. 0 = encode every source anew for every target.
   int feature_cache_mb = 2048;
+  // Network methods: a target wider or taller than tile_size pixels is blended in tiles
+  // of at most tile_size x tile_size, each computed with tile_overlap more pixels of
+  // context on every side and cropped, so that memory stays bounded for any target size
+  // (the blending U-Net's activations and the warped features scale with the pixels of a
+  // tile, not of the target). Also faster on a CPU (cache): fvs_fast at 1920x1080, K = 5,
+  // 2 cores: untiled 41 s per frame and 7.5 GB, tiles of 1024 34 s and 3.1 GB, of 512
+  // 27 s and 2.4 GB. 0 = never tile.
   int tile_size = 512;
   int tile_overlap = 32;
   void Check() const;
