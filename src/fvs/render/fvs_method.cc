@@ -54,6 +54,13 @@ struct Tile {
   int cy0, cy1, cx0, cx1;
 };
 
+// Rows [y0, y1) and columns [x0, x1) of t, whose rows are dimension `dim` and columns the
+// next one (2 for [N,C,H,W], 1 for a [N,H,W,2] sampling grid). A view, not a copy.
+torch::Tensor Box(const torch::Tensor& t, int y0, int y1, int x0, int x1,
+                  int64_t dim = 2) {
+  return t.narrow(dim, y0, y1 - y0).narrow(dim + 1, x0, x1 - x0);
+}
+
 std::vector<Tile> Tiles(int width, int height, int tile_size, int overlap) {
   if (tile_size <= 0 || (width <= tile_size && height <= tile_size)) {
     return {Tile{0, height, 0, width, 0, height, 0, width}};
@@ -151,24 +158,19 @@ class FvsMethod : public Method {
     bool have_weights = false;
     for (const Tile& tile : Tiles(w, h, options_.tile_size, options_.tile_overlap)) {
       // Pixels [y0, y1) x [x0, x1) of the target, computed over the larger context box.
-      auto context = [&](const torch::Tensor& t) {  // [N,C,H,W]
-        return t.narrow(2, tile.cy0, tile.cy1 - tile.cy0)
-            .narrow(3, tile.cx0, tile.cx1 - tile.cx0);
+      auto context = [&](const torch::Tensor& t, int64_t dim = 2) {
+        return Box(t, tile.cy0, tile.cy1, tile.cx0, tile.cx1, dim);
       };
       auto core = [&](const torch::Tensor& t) {  // of a context-sized tensor
-        return t.narrow(2, tile.y0 - tile.cy0, tile.y1 - tile.y0)
-            .narrow(3, tile.x0 - tile.cx0, tile.x1 - tile.x0);
+        return Box(t, tile.y0 - tile.cy0, tile.y1 - tile.cy0, tile.x0 - tile.cx0,
+                   tile.x1 - tile.cx0);
       };
       auto target_core = [&](const torch::Tensor& t) {
-        return t.narrow(2, tile.y0, tile.y1 - tile.y0)
-            .narrow(3, tile.x0, tile.x1 - tile.x0);
+        return Box(t, tile.y0, tile.y1, tile.x0, tile.x1);
       };
       std::vector<torch::Tensor> warped(k);
       for (int i = 0; i < k; ++i) {
-        const torch::Tensor grid = grids[i]
-                                       .narrow(1, tile.cy0, tile.cy1 - tile.cy0)
-                                       .narrow(2, tile.cx0, tile.cx1 - tile.cx0);
-        warped[i] = WarpFeatures(features[i], grid).to(dtype_);
+        warped[i] = WarpFeatures(features[i], context(grids[i], 1)).to(dtype_);
       }
       const torch::Tensor tile_mask = context(warp_mask);
       const BlendOutput out = net_->Blend(
@@ -183,10 +185,10 @@ class FvsMethod : public Method {
       }
     }
     // [-1,1] -> [0,1]; the net clamps and removes NaN at inference.
-    result.color = TensorToImage(((rgb + 1.0) * 0.5).cpu());
-    const torch::Tensor covered = (warp_mask.sum(0, true) > 0).to(torch::kFloat32).cpu();
-    result.coverage = TensorToImage(covered);
-    result.confidence = have_weights ? TensorToImage(seen_weight.cpu()) : result.coverage;
+    // (TensorToImage brings any device and dtype to a float image on the CPU.)
+    result.color = TensorToImage((rgb + 1.0) * 0.5);
+    result.coverage = TensorToImage(warp_mask.sum(0, true) > 0);
+    result.confidence = have_weights ? TensorToImage(seen_weight) : result.coverage;
     result.timings.blend_s = timer.Seconds() - result.timings.encode_s;
     return result;
   }
@@ -207,20 +209,24 @@ class FvsMethod : public Method {
                                     .contiguous(torch::MemoryFormat::ChannelsLast);
     torch::Tensor features = net_->Encode(image);
     encode_seconds_ += timer.Seconds();
-    const int64_t bytes = features.numel() * features.element_size();
     const int64_t budget = static_cast<int64_t>(options_.feature_cache_mb) << 20;
-    while (!order_.empty() && cache_bytes_ + bytes > budget) {
-      const auto old = cache_.find(order_.back());
-      cache_bytes_ -= old->second.numel() * old->second.element_size();
-      cache_.erase(old);
+    while (!order_.empty() && CacheBytes() + Bytes(features) > budget) {
+      cache_.erase(order_.back());
       order_.pop_back();
     }
-    if (bytes <= budget) {
+    if (Bytes(features) <= budget) {
       order_.push_front(view);
-      cache_bytes_ += bytes;
       cache_.emplace(view, features);
     }
     return features;
+  }
+
+  static int64_t Bytes(const torch::Tensor& t) { return t.numel() * t.element_size(); }
+  // A few dozen entries at most: summed when needed rather than kept in step.
+  int64_t CacheBytes() const {
+    int64_t sum = 0;
+    for (const auto& [view, features] : cache_) sum += Bytes(features);
+    return sum;
   }
 
   FvsNet net_;
@@ -230,7 +236,6 @@ class FvsMethod : public Method {
   torch::ScalarType dtype_;
   std::map<int, torch::Tensor> cache_;
   std::list<int> order_;
-  int64_t cache_bytes_ = 0;
   double encode_seconds_ = 0;
 };
 
