@@ -13,17 +13,23 @@
 namespace fvs::eval {
 namespace {
 
-TEST(Stability, EveryCaseIsFiniteAndTranslationInvariant) {
-  testing::TempDir dir;
+// A 40x30 suite with random fvs_fast weights saved in `dir`.
+StabilityOptions WithRandomFastNetwork(const testing::TempDir& dir) {
   torch::manual_seed(3);
   const ModelConfig config = ModelConfig::ForVariant("fvs_fast");
   FvsNet net(config);
   StabilityOptions options;
   options.model_path = dir / "fvs_fast.safetensors";
   SaveWeights(net, config, options.model_path, /*fp16=*/false);
-  options.methods = {"nearest", "ulr", "fvs_fast"};
   options.width = 40;
   options.height = 30;
+  return options;
+}
+
+TEST(Stability, EveryCaseIsFiniteAndTranslationInvariant) {
+  testing::TempDir dir;
+  StabilityOptions options = WithRandomFastNetwork(dir);
+  options.methods = {"nearest", "ulr", "fvs_fast"};
   const std::vector<StabilityResult> results = RunStabilitySuite(options);
   ASSERT_EQ(results.size(), StabilityCaseNames().size() * 3);
   for (const StabilityResult& r : results) {
@@ -45,17 +51,10 @@ TEST(Stability, EveryCaseIsFiniteAndTranslationInvariant) {
 // The network's reduced-precision and tiled paths face the same extremes.
 TEST(Stability, Bf16AndTilesStayFiniteAndTranslationInvariant) {
   testing::TempDir dir;
-  torch::manual_seed(3);
-  const ModelConfig config = ModelConfig::ForVariant("fvs_fast");
-  FvsNet net(config);
-  StabilityOptions options;
-  options.model_path = dir / "fvs_fast.safetensors";
-  SaveWeights(net, config, options.model_path, /*fp16=*/false);
+  StabilityOptions options = WithRandomFastNetwork(dir);
   options.methods = {"fvs_fast"};
   options.precision = "bf16";
   options.tile_size = 16;  // 3 x 2 tiles of 40x30
-  options.width = 40;
-  options.height = 30;
   for (const StabilityResult& r : RunStabilitySuite(options)) {
     EXPECT_TRUE(r.error.empty()) << r.case_name << ": " << r.error;
     EXPECT_EQ(r.nan_count + r.inf_count, 0) << r.case_name;
