@@ -30,31 +30,19 @@ namespace {
 using raster_internal::ClipPlanes;
 using raster_internal::ClipPolygon;
 using raster_internal::kGuardPixels;
+using raster_internal::kInvalid;
+using raster_internal::kNeedsClip;
+using raster_internal::kOutsideMask;
 using raster_internal::kSubPixel;
 using raster_internal::kSubPixelBits;
 using raster_internal::Polygon;
+using raster_internal::ScreenVertex;
 using raster_internal::SnapToFixed;
-
-enum VertexCode : uint32_t {
-  kLeft = 1,
-  kRight = 2,
-  kTop = 4,
-  kBottom = 8,
-  kBehind = 16,
-  kOutsideMask = 31,
-  kNeedsClip = 32,  // behind the near plane or outside the guard band: no fixed point
-  kInvalid = 64,    // non-finite
-};
 
 // One thread's z-buffer (inverse depth, 0 = empty) and face ids.
 struct Target {
   float* inverse_depth;
   int32_t* face_ids;  // null when ids are not needed
-};
-
-struct ScreenVertex {
-  int32_t x = 0, y = 0;  // fixed point, pixel centre (px, py) at (px, py) * kSubPixel
-  uint32_t code = 0;
 };
 
 constexpr double kMaxFloat = std::numeric_limits<float>::max();
@@ -77,7 +65,6 @@ class Rasterizer {
   void Run(RasterResult* result);
 
  private:
-  void TransformVertices(int64_t begin, int64_t end);
   template <bool kWriteIds>
   void RasterizeFaces(int64_t begin, int64_t end, Target target);
   template <bool kWriteIds>
@@ -96,7 +83,7 @@ class Rasterizer {
   // Camera-frame position of a vertex, recomputed on demand (cheaper than storing 24
   // bytes per vertex and faulting in fresh pages on every call).
   Eigen::Vector3d CameraVertex(int index) const {
-    return camera_.R * mesh_.vertices[index] + camera_.t;
+    return raster_internal::ToCameraFrame(camera_, mesh_.vertices[index]);
   }
 
   const TriangleMesh& mesh_;
@@ -135,34 +122,6 @@ class Rasterizer {
   std::vector<std::vector<int32_t>>& face_ids_ = scratch_.face_ids;
   bool want_ids_ = false;
 };
-
-void Rasterizer::TransformVertices(int64_t begin, int64_t end) {
-  const Eigen::Matrix3d& R = camera_.R;
-  const Eigen::Vector3d& t = camera_.t;
-  const double fx = camera_.fx, fy = camera_.fy, cx = camera_.cx, cy = camera_.cy;
-  const double w = width_, h = height_;
-  for (int64_t i = begin; i < end; ++i) {
-    const Eigen::Vector3d p = R * mesh_.vertices[i] + t;
-    ScreenVertex& s = screen_[i];
-    s.code = 0;
-    if (!p.allFinite()) {
-      s.code = kInvalid;
-      continue;
-    }
-    // Half-space tests of the view frustum, valid for any z (the frustum is convex, so a
-    // face with all vertices outside one plane is invisible).
-    const double z = p.z();
-    if (fx * p.x() + cx * z < 0) s.code |= kLeft;
-    if (fx * p.x() + (cx - w) * z > 0) s.code |= kRight;
-    if (fy * p.y() + cy * z < 0) s.code |= kTop;
-    if (fy * p.y() + (cy - h) * z > 0) s.code |= kBottom;
-    if (z < options_.near_plane) {
-      s.code |= kBehind | kNeedsClip;
-    } else if (!SnapToFixed(camera_, p, &s.x, &s.y)) {
-      s.code |= kNeedsClip;
-    }
-  }
-}
 
 bool Rasterizer::DepthPlane(int32_t face, double* a, double* b, double* c) const {
   // The face's plane n.X = n.V0 in world coordinates; in the camera frame its normal is
@@ -361,7 +320,11 @@ void Rasterizer::Run(RasterResult* result) {
   const int64_t num_faces = static_cast<int64_t>(mesh_.faces.size());
   screen_.resize(num_vertices);
   ParallelForRanges(
-      0, num_vertices, [&](int64_t b, int64_t e, int) { TransformVertices(b, e); },
+      0, num_vertices,
+      [&](int64_t b, int64_t e, int) {
+        raster_internal::TransformToScreen(camera_, options_.near_plane,
+                                           mesh_.vertices.data(), b, e, screen_.data());
+      },
       num_threads_);
 
   const size_t num_pixels = static_cast<size_t>(width_) * height_;
