@@ -2,10 +2,11 @@
 //
 // Stages: (1) every vertex goes to the camera frame in double and, when in front of the
 // near plane and inside a guard band, to fixed-point pixel coordinates (1/32768 px);
-// (2) each thread rasterises a contiguous range of faces into its own z-buffer (no locks,
-// no face looked at twice); (3) the buffers are merged per pixel, the lower thread
-// winning ties, so the result is the same as one thread drawing the faces in order (first
-// wins); (4) colours are shaded afterwards, once per pixel, from the winning face ids.
+// (2) each thread rasterises runs of faces, taken in order from a shared counter, into
+// its own z-buffer (no locks, no face looked at twice); (3) the buffers are merged per
+// pixel, the lower face winning ties, so the result is the same as one thread drawing the
+// faces in order (first wins); (4) colours are shaded afterwards, once per pixel, from
+// the winning face ids.
 //
 // Coverage uses exact integer edge functions with a top-left rule: two triangles sharing
 // an edge never both cover, and never both miss, a pixel centre on it (no cracks). Depth
@@ -17,6 +18,7 @@
 #include "fvs/geometry/rasterizer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -300,12 +302,18 @@ void Rasterizer::Merge(int64_t row_begin, int64_t row_end, float* depth) {
   for (int t = 1; t < num_threads_; ++t) {
     const float* other = inverse_depth_[t].data();
     const int32_t* other_id = want_ids_ ? face_ids_[t].data() : nullptr;
-    for (size_t i = begin; i < end; ++i) {
-      // Strictly greater: on a tie the lower thread, which drew the lower face, wins.
-      if (other[i] > best[i]) {
-        best[i] = other[i];
-        if (best_id) best_id[i] = other_id[i];
+    if (best_id) {
+      for (size_t i = begin; i < end; ++i) {
+        // Equal depth: the lower face wins, as when one thread draws all faces in order.
+        if (other[i] > best[i] ||
+            (other[i] == best[i] && other_id[i] < best_id[i] && other_id[i] >= 0)) {
+          best[i] = other[i];
+          best_id[i] = other_id[i];
+        }
       }
+    } else {
+      // Depth only: which of two faces at equal depth wins does not change the depth.
+      for (size_t i = begin; i < end; ++i) best[i] = std::max(best[i], other[i]);
     }
   }
   for (size_t i = begin; i < end; ++i) {
@@ -331,6 +339,8 @@ void Rasterizer::Run(RasterResult* result) {
   want_ids_ = options_.compute_face_ids || options_.compute_color;
   inverse_depth_.resize(num_threads_);
   face_ids_.resize(num_threads_);
+  constexpr int64_t kMinChunk = 8192;
+  std::atomic<int64_t> next_face{0};
   ParallelForRanges(
       0, num_threads_,
       [&](int64_t t, int64_t, int) {
@@ -339,12 +349,25 @@ void Rasterizer::Run(RasterResult* result) {
         if (want_ids_) face_ids_[t].assign(num_pixels, -1);
         const Target target{inverse_depth_[t].data(),
                             want_ids_ ? face_ids_[t].data() : nullptr};
-        const int64_t begin = num_faces * t / num_threads_;
-        const int64_t end = num_faces * (t + 1) / num_threads_;
-        if (want_ids_) {
-          RasterizeFaces<true>(begin, end, target);
-        } else {
-          RasterizeFaces<false>(begin, end, target);
+        // Guided self-scheduling: chunks of a shrinking share of the faces left, taken
+        // in increasing order, so each thread still draws its faces in order (the first
+        // of equal depth wins) and mostly in long contiguous runs (the z-buffer lines a
+        // run touches are the ones its neighbour faces touch). Equal halves were up to
+        // 2x unbalanced: a view's cost is far from uniform over the face list.
+        while (true) {
+          int64_t begin = next_face.load(std::memory_order_relaxed), end = 0;
+          do {
+            const int64_t left = num_faces - begin;
+            if (left <= 0) return;
+            end = begin + std::max<int64_t>(left / (2 * num_threads_), kMinChunk);
+            end = std::min(end, num_faces);
+          } while (
+              !next_face.compare_exchange_weak(begin, end, std::memory_order_relaxed));
+          if (want_ids_) {
+            RasterizeFaces<true>(begin, end, target);
+          } else {
+            RasterizeFaces<false>(begin, end, target);
+          }
         }
       },
       num_threads_);
