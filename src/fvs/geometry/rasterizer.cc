@@ -198,6 +198,38 @@ void Rasterizer::RasterizeTriangle(int32_t face, int64_t x0, int64_t y0, int64_t
     step_x[i] = -ey[i] * kSubPixel;
     step_y[i] = ex[i] * kSubPixel;
   }
+  if (px1 - px0 < 4 && py1 - py0 < 4) {
+    // Boxes of up to 4x4 candidates, nine in ten of the faces that get here on a dense
+    // mesh: coverage as a bit mask (bit 4 row + column), computed without branches,
+    // whose outcome per pixel is a coin toss for a face of about a pixel.
+    const uint32_t row_bits = (1u << (px1 - px0 + 1)) - 1;
+    uint32_t mask = 0;
+    for (int64_t row = 0; row <= py1 - py0; ++row) {
+      uint32_t bits = 0;
+      for (int column = 0; column < 4; ++column) {
+        const int64_t e = (row_e[0] + column * step_x[0]) |
+                          (row_e[1] + column * step_x[1]) |
+                          (row_e[2] + column * step_x[2]);
+        bits |= static_cast<uint32_t>(~static_cast<uint64_t>(e) >> 63) << column;
+      }
+      mask |= (bits & row_bits) << (4 * row);
+      for (int i = 0; i < 3; ++i) row_e[i] += step_y[i];
+    }
+    if (mask == 0 || !DepthPlane(face, &da, &db, &dc)) return;
+    do {
+      const int bit = __builtin_ctz(mask);
+      mask &= mask - 1;
+      const int64_t px = px0 + (bit & 3), py = py0 + (bit >> 2);
+      const size_t index = static_cast<size_t>(py) * width_ + px;
+      const float inv_z = static_cast<float>(da * static_cast<double>(px) +
+                                             (db * static_cast<double>(py) + dc));
+      if (inv_z > target.inverse_depth[index] && inv_z <= max_inverse_depth_) {
+        target.inverse_depth[index] = inv_z;
+        if (kWriteIds) target.face_ids[index] = face;
+      }
+    } while (mask != 0);
+    return;
+  }
   for (int64_t py = py0; py <= py1; ++py) {
     int64_t e[3] = {row_e[0], row_e[1], row_e[2]};
     const int64_t* step = step_x;
