@@ -9,10 +9,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "fvs/net/net.h"
 #include "fvs/render/method.h"
 #include "fvs/util/error.h"
+#include "fvs/util/safetensors.h"
 #include "scene/scene_fixture.h"
 #include "support/test_support.h"
 
@@ -74,6 +77,63 @@ TEST(FvsMethod, FiniteDeterministicAndCached) {
     EXPECT_EQ(a.color.data, c.color.data);
     EXPECT_GT(c.timings.encode_s, 0.0);
   }
+}
+
+std::vector<std::string> FilesBelow(const std::string& dir) {
+  std::vector<std::string> files;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
+    if (entry.is_regular_file()) files.push_back(entry.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// --disk_feature_cache: a second run reads the features the first one encoded (the very
+// same image), a damaged file is encoded again, other weights never read them.
+TEST(FvsMethod, FeaturesKeptOnDiskAreReadByTheNextRun) {
+  testing::TempDir dir;
+  const Scene scene = testing::MakeTestScene(5, 48, 36);
+  RenderOptions options;
+  options.num_sources = 3;
+  options.model_path = SaveRandomModel(dir.path(), "fvs_fast");
+  options.feature_cache_dir = dir / "features";
+  const TargetView target = HeldOutTarget(scene, 2);
+  const RenderResult fresh = CreateMethod("fvs", options)->Render(scene, target);
+  const std::vector<std::string> stored = FilesBelow(options.feature_cache_dir);
+  ASSERT_EQ(stored.size(), 3u);  // one per source used, nothing else (no temporaries)
+
+  // A new run (empty memory cache): the same image from the stored features.
+  EXPECT_EQ(CreateMethod("fvs", options)->Render(scene, target).color.data,
+            fresh.color.data);
+
+  // Proof that they are read: features zeroed on disk change the image.
+  for (const std::string& path : stored) {
+    SafeTensorsFile file = ReadSafeTensors(path);
+    SafeTensor zeros = file.tensors.at(0);
+    std::fill(zeros.data.begin(), zeros.data.end(), 0);
+    file.Add(zeros);
+    WriteSafeTensors(path, file);
+  }
+  EXPECT_NE(CreateMethod("fvs", options)->Render(scene, target).color.data,
+            fresh.color.data);
+
+  // Truncated files: a warning, the sources encoded again, the files rewritten whole.
+  for (const std::string& path : stored) {
+    std::filesystem::resize_file(path, 100);
+  }
+  EXPECT_EQ(CreateMethod("fvs", options)->Render(scene, target).color.data,
+            fresh.color.data);
+  for (const std::string& path : stored) EXPECT_NO_THROW(ReadSafeTensors(path));
+  EXPECT_EQ(FilesBelow(options.feature_cache_dir), stored);
+
+  // Other weights (same variant, other values): their own folder, stored features unused.
+  torch::manual_seed(8);
+  const ModelConfig config = ModelConfig::ForVariant("fvs_fast");
+  FvsNet other(config);
+  options.model_path = dir / "other.safetensors";
+  SaveWeights(other, config, options.model_path, /*fp16=*/false);
+  CreateMethod("fvs", options)->Render(scene, target);
+  EXPECT_EQ(FilesBelow(options.feature_cache_dir).size(), 6u);
 }
 
 TEST(FvsMethod, EveryVariantRendersFiniteImages) {

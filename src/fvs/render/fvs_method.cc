@@ -8,6 +8,7 @@
 
 #include "fvs/net/image_tensor.h"
 #include "fvs/net/net.h"
+#include "fvs/render/feature_store.h"
 #include "fvs/render/prepare.h"
 #include "fvs/render/ulr.h"
 #include "fvs/scene/scene.h"
@@ -103,6 +104,11 @@ class FvsMethod : public Method {
     for (auto& p : net_->parameters()) {
       if (p.dim() == 4) p.set_data(p.contiguous(torch::MemoryFormat::ChannelsLast));
     }
+    if (!options_.feature_cache_dir.empty()) {
+      store_ =
+          std::make_unique<FeatureStore>(options_.feature_cache_dir, options_.model_path,
+                                         config_.variant, options_.precision);
+    }
   }
 
   std::string name() const override { return config_.variant; }
@@ -195,7 +201,8 @@ class FvsMethod : public Method {
 
  private:
   // Encoded features of a source view, cached (least recently used out first, within
-  // RenderOptions::feature_cache_mb) so a path of targets encodes each source once.
+  // RenderOptions::feature_cache_mb) so a path of targets encodes each source once; and,
+  // with RenderOptions::feature_cache_dir, read from and written to disk.
   torch::Tensor Features(const Scene& scene, int view) {
     const auto it = cache_.find(view);
     if (it != cache_.end()) {
@@ -204,10 +211,24 @@ class FvsMethod : public Method {
       return it->second;
     }
     Timer timer;
-    const torch::Tensor image = (ImageToTensor(scene.SourceImage(view)) * 2.0 - 1.0)
-                                    .to(device_, dtype_)
-                                    .contiguous(torch::MemoryFormat::ChannelsLast);
-    torch::Tensor features = net_->Encode(image);
+    const Image& photo = scene.SourceImage(view);
+    torch::Tensor features;
+    std::string stored_path;
+    if (store_) {
+      stored_path = store_->PathFor(photo);
+      const int64_t channels = config_.feature_channels + (config_.rgb_skip ? 3 : 0);
+      features = store_->Load(stored_path, channels, photo, dtype_);
+      if (features.defined()) {
+        features = features.to(device_).contiguous(torch::MemoryFormat::ChannelsLast);
+      }
+    }
+    if (!features.defined()) {
+      const torch::Tensor image = (ImageToTensor(photo) * 2.0 - 1.0)
+                                      .to(device_, dtype_)
+                                      .contiguous(torch::MemoryFormat::ChannelsLast);
+      features = net_->Encode(image);
+      if (store_) store_->Save(stored_path, features, scene.view(view).name);
+    }
     encode_seconds_ += timer.Seconds();
     const int64_t budget = static_cast<int64_t>(options_.feature_cache_mb) << 20;
     while (!order_.empty() && CacheBytes() + Bytes(features) > budget) {
@@ -234,6 +255,7 @@ class FvsMethod : public Method {
   RenderOptions options_;
   torch::Device device_;
   torch::ScalarType dtype_;
+  std::unique_ptr<FeatureStore> store_;  // on disk, when options_.feature_cache_dir
   std::map<int, torch::Tensor> cache_;
   std::list<int> order_;
   double encode_seconds_ = 0;

@@ -63,6 +63,12 @@ struct RenderOptions {
   // path encodes each source once). 64 channels of a 640x480 photo take 79 MB, of a
   // 1920x1080 one 530 MB. 0 = encode every source anew for every target.
   int feature_cache_mb = 2048;
+  // Network methods: also keep encoded source features in this folder (one file per
+  // source photo, weights and precision; render/feature_store.h), so that another run
+  // reads them instead of encoding. As large as the photos' features (64 channels of
+  // fp32: 79 MB for a 640x480 photo). Empty = memory only. view_synthesis
+  // --disk_feature_cache 1 uses W/fvs/features.
+  std::string feature_cache_dir;
   // Network methods: a target wider or taller than tile_size pixels is blended in tiles
   // of at most tile_size x tile_size, each computed with tile_overlap more pixels of
   // context on every side and cropped, so that memory stays bounded for any target size

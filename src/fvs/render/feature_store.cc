@@ -1,0 +1,106 @@
+#include "fvs/render/feature_store.h"
+
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+
+#include "fvs/util/atomic_file.h"
+#include "fvs/util/error.h"
+#include "fvs/util/hash.h"
+#include "fvs/util/safetensors.h"
+#include "fvs/util/string_util.h"
+
+namespace fvs {
+namespace {
+
+bool ToSafeDtype(torch::ScalarType type, SafeDtype* out) {
+  switch (type) {
+    case torch::kFloat32:
+      *out = SafeDtype::kF32;
+      return true;
+    case torch::kBFloat16:
+      *out = SafeDtype::kBF16;
+      return true;
+    case torch::kHalf:
+      *out = SafeDtype::kF16;
+      return true;
+    default:
+      return false;
+  }
+}
+
+std::string ShapeText(const std::vector<int64_t>& shape) {
+  std::string text = "[";
+  for (size_t i = 0; i < shape.size(); ++i) {
+    text += (i ? "," : "") + std::to_string(shape[i]);
+  }
+  return text + "]";
+}
+
+}  // namespace
+
+FeatureStore::FeatureStore(const std::string& dir, const std::string& model_path,
+                           const std::string& variant, const std::string& precision) {
+  const std::string weights = ReadFileToString(model_path);
+  weights_hash_ = HexHash(Hash64(weights.data(), weights.size()));
+  folder_ = JoinPaths(dir, variant + "-" + weights_hash_ + "-" + precision);
+  std::error_code ec;
+  std::filesystem::create_directories(folder_, ec);
+  Require(!ec, folder_, "cannot create the feature cache folder: " + ec.message());
+}
+
+std::string FeatureStore::PathFor(const Image& photo) const {
+  const int64_t size[3] = {photo.width, photo.height, photo.channels};
+  const uint64_t seed = Hash64(size, sizeof(size));
+  return JoinPaths(folder_, HexHash(Hash64(photo.data.data(),
+                                           photo.data.size() * sizeof(float), seed)) +
+                                ".safetensors");
+}
+
+torch::Tensor FeatureStore::Load(const std::string& path, int64_t channels,
+                                 const Image& photo, torch::ScalarType dtype) const {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return {};
+  try {
+    const SafeTensorsFile file = ReadSafeTensors(path);
+    const SafeTensor* t = file.Find("features");
+    Require(t != nullptr, path, "no tensor 'features'");
+    SafeDtype want;
+    Require(ToSafeDtype(dtype, &want) && t->dtype == want, path,
+            "features are " + SafeDtypeName(t->dtype) + ", this run needs " +
+                std::string(c10::toString(dtype)));
+    const std::vector<int64_t> shape = {1, channels, photo.height, photo.width};
+    Require(
+        t->shape == shape, path,
+        "features of shape " + ShapeText(t->shape) + ", expected " + ShapeText(shape));
+    torch::Tensor out = torch::empty(shape, torch::TensorOptions().dtype(dtype));
+    std::memcpy(out.data_ptr(), t->data.data(), t->data.size());
+    return out;
+  } catch (const std::exception& e) {
+    std::cerr << "WARNING: " << e.what() << "; encoding that source again\n";
+    return {};
+  }
+}
+
+void FeatureStore::Save(const std::string& path, const torch::Tensor& features,
+                        const std::string& photo_name) const {
+  try {
+    const torch::Tensor cpu = features.detach().to(torch::kCPU).contiguous();
+    SafeTensor t;
+    t.name = "features";
+    Require(ToSafeDtype(cpu.scalar_type(), &t.dtype), path, "unsupported feature dtype");
+    t.shape = cpu.sizes().vec();
+    t.data.resize(cpu.numel() * cpu.element_size());
+    std::memcpy(t.data.data(), cpu.data_ptr(), t.data.size());
+    SafeTensorsFile file;
+    file.Add(std::move(t));
+    file.metadata["photo"] = photo_name;
+    file.metadata["weights_hash"] = weights_hash_;
+    WriteSafeTensors(path, file);
+  } catch (const std::exception& e) {
+    std::cerr << "WARNING: " << e.what() << "; features of " << photo_name
+              << " not kept on disk\n";
+  }
+}
+
+}  // namespace fvs

@@ -1,0 +1,15 @@
+// A 64-bit content hash (FNV-1a over 8-byte words, then a splitmix64 finaliser) for cache
+// keys: which weights, which photo. Not cryptographic; fast (about 2 GB/s here).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace fvs {
+
+uint64_t Hash64(const void* data, size_t bytes, uint64_t seed = 0);
+// 16 lower-case hex digits.
+std::string HexHash(uint64_t hash);
+
+}  // namespace fvs
