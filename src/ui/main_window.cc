@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fvs/util/string_util.h"
 #include "ui/path_panel.h"
 #include "ui/result_panel.h"
 #include "ui/scene_view.h"
@@ -374,6 +375,9 @@ RenderRequest MainWindow::CurrentRequest() const {
   request.width = width_->value();
   request.height = height_->value();
   request.model_path = model_path_->text().trimmed().toStdString();
+  if (contents_ && MethodNeedsWeights(request.method)) {
+    request.feature_cache_dir = JoinPaths(contents_->path, "fvs/features");
+  }
   return request;
 }
 

@@ -18,6 +18,7 @@ RenderOptions RenderRequest::ToRenderOptions() const {
   RenderOptions options;
   options.num_sources = num_sources;
   options.model_path = model_path;
+  options.feature_cache_dir = feature_cache_dir;
   return options;
 }
 

@@ -17,6 +17,10 @@ struct RenderRequest {
   int width = 640;
   int height = 480;
   std::string model_path;  // weights, for the fvs methods
+  // Encoded source features kept here for the next render (the window's workspace's
+  // fvs/features): each render creates its method afresh, so without it every click
+  // would encode every source again. Empty = none.
+  std::string feature_cache_dir;
   // Throws fvs::Error naming the setting that is out of range.
   void Check() const;
   RenderOptions ToRenderOptions() const;
