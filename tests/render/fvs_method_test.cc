@@ -22,11 +22,15 @@
 namespace fvs {
 namespace {
 
-std::string SaveRandomModel(const std::string& dir, const std::string& variant) {
-  torch::manual_seed(7);
+// Random weights of `variant` (from `seed`) saved as <dir>/<file_stem>.safetensors
+// (default: the variant's name).
+std::string SaveRandomModel(const std::string& dir, const std::string& variant,
+                            int seed = 7, const std::string& file_stem = "") {
+  torch::manual_seed(seed);
   const ModelConfig config = ModelConfig::ForVariant(variant);
   FvsNet net(config);
-  const std::string path = dir + "/" + variant + ".safetensors";
+  const std::string path =
+      dir + "/" + (file_stem.empty() ? variant : file_stem) + ".safetensors";
   SaveWeights(net, config, path, /*fp16=*/false);
   return path;
 }
@@ -127,11 +131,7 @@ TEST(FvsMethod, FeaturesKeptOnDiskAreReadByTheNextRun) {
   EXPECT_EQ(FilesBelow(options.feature_cache_dir), stored);
 
   // Other weights (same variant, other values): their own folder, stored features unused.
-  torch::manual_seed(8);
-  const ModelConfig config = ModelConfig::ForVariant("fvs_fast");
-  FvsNet other(config);
-  options.model_path = dir / "other.safetensors";
-  SaveWeights(other, config, options.model_path, /*fp16=*/false);
+  options.model_path = SaveRandomModel(dir.path(), "fvs_fast", /*seed=*/8, "other");
   CreateMethod("fvs", options)->Render(scene, target);
   EXPECT_EQ(FilesBelow(options.feature_cache_dir).size(), 6u);
 }
