@@ -101,6 +101,7 @@ TEST(FvsMethod, FeaturesKeptOnDiskAreReadByTheNextRun) {
   options.num_sources = 3;
   options.model_path = SaveRandomModel(dir.path(), "fvs_fast");
   options.feature_cache_dir = dir / "features";
+  const std::string stored_model = options.model_path;
   const TargetView target = HeldOutTarget(scene, 2);
   const RenderResult fresh = CreateMethod("fvs", options)->Render(scene, target);
   const std::vector<std::string> stored = FilesBelow(options.feature_cache_dir);
@@ -134,6 +135,21 @@ TEST(FvsMethod, FeaturesKeptOnDiskAreReadByTheNextRun) {
   options.model_path = SaveRandomModel(dir.path(), "fvs_fast", /*seed=*/8, "other");
   CreateMethod("fvs", options)->Render(scene, target);
   EXPECT_EQ(FilesBelow(options.feature_cache_dir).size(), 6u);
+
+  // Over the size limit (0 here) the least recently used files go, never the one just
+  // written: one file left, the render unchanged.
+  options.model_path = stored_model;
+  options.feature_cache_dir = dir / "small";
+  options.feature_cache_disk_mb = 0;
+  EXPECT_EQ(CreateMethod("fvs", options)->Render(scene, target).color.data,
+            fresh.color.data);
+  EXPECT_EQ(FilesBelow(options.feature_cache_dir).size(), 1u);
+
+  // A folder that cannot be created (a file in the way): a warning, the same render.
+  testing::WriteTextFile(dir / "a_file", "not a folder");
+  options.feature_cache_dir = dir / "a_file/features";
+  EXPECT_EQ(CreateMethod("fvs", options)->Render(scene, target).color.data,
+            fresh.color.data);
 }
 
 TEST(FvsMethod, EveryVariantRendersFiniteImages) {

@@ -220,6 +220,9 @@ int RunViewSynthesis(int argc, char** argv) {
                      "--method fvs: also keep encoded source features in "
                      "W/fvs/features/, read by later runs instead of encoding (about "
                      "80 MB per 640x480 source)");
+  options.AddDefault("feature_cache_disk_mb", &o.render.feature_cache_disk_mb,
+                     "--disk_feature_cache: size limit of W/fvs/features (least recently "
+                     "used out first)");
   options.AddDefault("tile_size", &o.render.tile_size,
                      "--method fvs: blend targets larger than this in tiles of at most "
                      "this size, to bound memory (0: never)");

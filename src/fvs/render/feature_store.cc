@@ -1,5 +1,6 @@
 #include "fvs/render/feature_store.h"
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -40,7 +41,9 @@ std::string ShapeText(const std::vector<int64_t>& shape) {
 }  // namespace
 
 FeatureStore::FeatureStore(const std::string& dir, const std::string& model_path,
-                           const std::string& variant, const std::string& precision) {
+                           const std::string& variant, const std::string& precision,
+                           int64_t max_bytes)
+    : dir_(dir), max_bytes_(max_bytes) {
   const std::string weights = ReadFileToString(model_path);
   weights_hash_ = HexHash(Hash64(weights.data(), weights.size()));
   folder_ = JoinPaths(dir, variant + "-" + weights_hash_ + "-" + precision);
@@ -75,6 +78,9 @@ torch::Tensor FeatureStore::Load(const std::string& path, int64_t channels,
         "features of shape " + ShapeText(t->shape) + ", expected " + ShapeText(shape));
     torch::Tensor out = torch::empty(shape, torch::TensorOptions().dtype(dtype));
     std::memcpy(out.data_ptr(), t->data.data(), t->data.size());
+    // Recently used: the last to go when the folder is over its limit.
+    std::filesystem::last_write_time(path, std::filesystem::file_time_type::clock::now(),
+                                     ec);
     return out;
   } catch (const std::exception& e) {
     std::cerr << "WARNING: " << e.what() << "; encoding that source again\n";
@@ -100,6 +106,34 @@ void FeatureStore::Save(const std::string& path, const torch::Tensor& features,
   } catch (const std::exception& e) {
     std::cerr << "WARNING: " << e.what() << "; features of " << photo_name
               << " not kept on disk\n";
+    return;
+  }
+  Prune(path);
+}
+
+void FeatureStore::Prune(const std::string& keep) const {
+  struct Stored {
+    std::filesystem::file_time_type time;
+    std::string path;
+    int64_t bytes;
+  };
+  std::vector<Stored> files;
+  int64_t total = 0;
+  std::error_code ec;
+  for (auto it = std::filesystem::recursive_directory_iterator(dir_, ec);
+       !ec && it != std::filesystem::recursive_directory_iterator(); it.increment(ec)) {
+    if (!it->is_regular_file(ec) || it->path().extension() != ".safetensors") continue;
+    Stored f{it->last_write_time(ec), it->path().string(),
+             static_cast<int64_t>(it->file_size(ec))};
+    if (ec) continue;  // removed meanwhile (another process pruning)
+    total += f.bytes;
+    if (f.path != keep) files.push_back(std::move(f));
+  }
+  std::sort(files.begin(), files.end(),
+            [](const Stored& a, const Stored& b) { return a.time < b.time; });
+  for (const Stored& f : files) {
+    if (total <= max_bytes_) break;
+    if (std::filesystem::remove(f.path, ec)) total -= f.bytes;
   }
 }
 

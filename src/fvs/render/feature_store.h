@@ -8,7 +8,9 @@
 // Keys are content hashes (of the weights file, of the source's pixels as loaded), so
 // changed weights or a changed photo never read stale features. Written atomically;
 // a file that is unreadable or of the wrong shape or dtype is reported in one warning
-// line and encoded again. Included by fvs_method.cc only (LibTorch).
+// line and encoded again. The whole folder (all weights) is kept under a size limit, the
+// least recently used files (by modification time, refreshed on every read) removed
+// first. Included by fvs_method.cc only (LibTorch).
 #pragma once
 
 #include <torch/torch.h>
@@ -22,9 +24,11 @@ namespace fvs {
 
 class FeatureStore {
  public:
-  // Hashes the weights file (tens of ms for the reference network's).
+  // Hashes the weights file (tens of ms for the reference network's). max_bytes: the
+  // limit for all of `dir`.
   FeatureStore(const std::string& dir, const std::string& model_path,
-               const std::string& variant, const std::string& precision);
+               const std::string& variant, const std::string& precision,
+               int64_t max_bytes);
 
   // The file for a source photo (as the renderer loaded it).
   std::string PathFor(const Image& photo) const;
@@ -32,15 +36,21 @@ class FeatureStore {
   // an undefined tensor when there are none (or they do not fit: a warning).
   torch::Tensor Load(const std::string& path, int64_t channels, const Image& photo,
                      torch::ScalarType dtype) const;
-  // Best effort: a full disk or a read-only folder gives a warning, not an error.
+  // Best effort: a full disk or a read-only folder gives a warning, not an error. Then
+  // removes the least recently used files of the folder beyond the size limit (never
+  // the one just written).
   void Save(const std::string& path, const torch::Tensor& features,
             const std::string& photo_name) const;
 
   const std::string& folder() const { return folder_; }
 
  private:
+  void Prune(const std::string& keep) const;
+
+  std::string dir_;
   std::string folder_;
   std::string weights_hash_;
+  int64_t max_bytes_;
 };
 
 }  // namespace fvs

@@ -106,9 +106,13 @@ class FvsMethod : public Method {
       if (p.dim() == 4) p.set_data(p.contiguous(torch::MemoryFormat::ChannelsLast));
     }
     if (!options_.feature_cache_dir.empty()) {
-      store_ =
-          std::make_unique<FeatureStore>(options_.feature_cache_dir, options_.model_path,
-                                         config_.variant, options_.precision);
+      try {  // an optimisation: a read-only workspace renders, only slower
+        store_ = std::make_unique<FeatureStore>(
+            options_.feature_cache_dir, options_.model_path, config_.variant,
+            options_.precision, int64_t{options_.feature_cache_disk_mb} << 20);
+      } catch (const std::exception& e) {
+        std::cerr << "WARNING: " << e.what() << "; features are not kept on disk\n";
+      }
     }
   }
 

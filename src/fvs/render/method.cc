@@ -33,6 +33,7 @@ void RenderOptions::Check() const {
           "must be 0 (off) or at least 8");
   Require(tile_overlap >= 0, "--tile_overlap", "must be non-negative");
   Require(feature_cache_mb >= 0, "--feature_cache_mb", "must be non-negative");
+  Require(feature_cache_disk_mb >= 0, "--feature_cache_disk_mb", "must be non-negative");
   Require(device == "auto" || device == "cpu" || device == "cuda", "--device",
           "'" + device + "': must be auto, cpu or cuda");
   Require(KnownPrecision(precision), "--precision",

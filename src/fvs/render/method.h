@@ -67,8 +67,10 @@ struct RenderOptions {
   // source photo, weights and precision; render/feature_store.h), so that another run
   // reads them instead of encoding. As large as the photos' features (64 channels of
   // fp32: 79 MB for a 640x480 photo). Empty = memory only. view_synthesis
-  // --disk_feature_cache 1 uses W/fvs/features.
+  // --disk_feature_cache 1 uses W/fvs/features. The folder is kept within
+  // feature_cache_disk_mb (least recently used files removed first).
   std::string feature_cache_dir;
+  int feature_cache_disk_mb = 8192;
   // Network methods: a target wider or taller than tile_size pixels is blended in tiles
   // of at most tile_size x tile_size, each computed with tile_overlap more pixels of
   // context on every side and cropped, so that memory stays bounded for any target size
