@@ -21,13 +21,6 @@ std::vector<std::pair<std::string, torch::Tensor>> NamedTensors(const FvsNetImpl
   return out;
 }
 
-std::string ShapeString(const std::vector<int64_t>& shape) {
-  std::string s = "[";
-  for (size_t i = 0; i < shape.size(); ++i)
-    s += (i ? "," : "") + std::to_string(shape[i]);
-  return s + "]";
-}
-
 std::string ListProblems(const std::string& title,
                          const std::vector<std::string>& items) {
   std::string s = title + " (" + std::to_string(items.size()) + "): ";

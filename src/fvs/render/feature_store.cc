@@ -30,14 +30,6 @@ bool ToSafeDtype(torch::ScalarType type, SafeDtype* out) {
   }
 }
 
-std::string ShapeText(const std::vector<int64_t>& shape) {
-  std::string text = "[";
-  for (size_t i = 0; i < shape.size(); ++i) {
-    text += (i ? "," : "") + std::to_string(shape[i]);
-  }
-  return text + "]";
-}
-
 }  // namespace
 
 FeatureStore::FeatureStore(const std::string& dir, const std::string& model_path,
@@ -73,9 +65,9 @@ torch::Tensor FeatureStore::Load(const std::string& path, int64_t channels,
             "features are " + SafeDtypeName(t->dtype) + ", this run needs " +
                 std::string(c10::toString(dtype)));
     const std::vector<int64_t> shape = {1, channels, photo.height, photo.width};
-    Require(
-        t->shape == shape, path,
-        "features of shape " + ShapeText(t->shape) + ", expected " + ShapeText(shape));
+    Require(t->shape == shape, path,
+            "features of shape " + ShapeString(t->shape) + ", expected " +
+                ShapeString(shape));
     torch::Tensor out = torch::empty(shape, torch::TensorOptions().dtype(dtype));
     std::memcpy(out.data_ptr(), t->data.data(), t->data.size());
     // Recently used: the last to go when the folder is over its limit.

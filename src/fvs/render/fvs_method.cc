@@ -221,8 +221,7 @@ class FvsMethod : public Method {
     std::string stored_path;
     if (store_) {
       stored_path = store_->PathFor(photo);
-      const int64_t channels = config_.feature_channels + (config_.rgb_skip ? 3 : 0);
-      features = store_->Load(stored_path, channels, photo, dtype_);
+      features = store_->Load(stored_path, config_.EncodedChannels(), photo, dtype_);
       if (features.defined()) {
         features = features.to(device_).contiguous(torch::MemoryFormat::ChannelsLast);
       }

@@ -44,14 +44,6 @@ const DtypeInfo& Info(SafeDtype dtype) {
   return kDtypes[1];  // unreachable: every enumerator is listed
 }
 
-std::string ShapeString(const std::vector<int64_t>& shape) {
-  std::string s = "[";
-  for (size_t i = 0; i < shape.size(); ++i) {
-    s += (i ? ", " : "") + std::to_string(shape[i]);
-  }
-  return s + "]";
-}
-
 // Number of bytes of a tensor, or false when it would overflow (a hostile header).
 bool ByteCount(const std::vector<int64_t>& shape, size_t element_size, uint64_t* bytes) {
   uint64_t n = element_size;
@@ -123,6 +115,14 @@ Entry ParseEntry(const std::string& name, const nlohmann::json& value,
 }
 
 }  // namespace
+
+std::string ShapeString(const std::vector<int64_t>& shape) {
+  std::string s = "[";
+  for (size_t i = 0; i < shape.size(); ++i) {
+    s += (i ? ", " : "") + std::to_string(shape[i]);
+  }
+  return s + "]";
+}
 
 std::string SafeDtypeName(SafeDtype dtype) { return Info(dtype).name; }
 size_t SafeDtypeSize(SafeDtype dtype) { return Info(dtype).size; }

@@ -24,6 +24,9 @@ namespace fvs {
 
 enum class SafeDtype { kF64, kF32, kF16, kBF16, kI64, kI32, kI16, kI8, kU8, kBool };
 
+// "[2, 3]": a shape in error messages.
+std::string ShapeString(const std::vector<int64_t>& shape);
+
 // "F32", "BF16", ... as in the format.
 std::string SafeDtypeName(SafeDtype dtype);
 size_t SafeDtypeSize(SafeDtype dtype);
