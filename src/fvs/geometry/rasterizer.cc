@@ -337,8 +337,8 @@ void Rasterizer::Merge(int64_t row_begin, int64_t row_end, float* depth) {
     if (best_id) {
       for (size_t i = begin; i < end; ++i) {
         // Equal depth: the lower face wins, as when one thread draws all faces in order.
-        if (other[i] > best[i] ||
-            (other[i] == best[i] && other_id[i] < best_id[i] && other_id[i] >= 0)) {
+        // (Empty pixels, 0 and id -1 in both buffers, stay as they are.)
+        if (other[i] > best[i] || (other[i] == best[i] && other_id[i] < best_id[i])) {
           best[i] = other[i];
           best_id[i] = other_id[i];
         }
