@@ -41,5 +41,20 @@ TEST(ParallelFor, RethrowsWorkerException) {
                std::runtime_error);
 }
 
+TEST(ParallelFor, CallerChunkThrowsOnlyAfterTheWorkersFinish) {
+  // The calling thread runs the first chunk; its exception must not leave the call
+  // while a worker still uses the caller's stack.
+  std::atomic<int> done{0};
+  EXPECT_THROW(ParallelFor(
+                   0, 100,
+                   [&](int64_t i) {
+                     if (i == 0) throw std::runtime_error("boom");
+                     if (i >= 50) ++done;
+                   },
+                   2),
+               std::runtime_error);
+  EXPECT_EQ(done.load(), 50);
+}
+
 }  // namespace
 }  // namespace fvs

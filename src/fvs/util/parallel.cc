@@ -31,20 +31,20 @@ void ParallelForRanges(int64_t begin, int64_t end,
   }
   std::exception_ptr first_error;
   std::mutex mutex;
+  auto run = [&](int t) {
+    try {
+      fn(begin + n * t / threads, begin + n * (t + 1) / threads, t);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!first_error) first_error = std::current_exception();
+    }
+  };
+  // The calling thread takes the first chunk itself: one thread start fewer per call
+  // (callers such as the rasteriser make several calls per frame).
   std::vector<std::thread> workers;
-  workers.reserve(threads);
-  for (int t = 0; t < threads; ++t) {
-    const int64_t b = begin + n * t / threads;
-    const int64_t e = begin + n * (t + 1) / threads;
-    workers.emplace_back([&, b, e, t] {
-      try {
-        fn(b, e, t);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!first_error) first_error = std::current_exception();
-      }
-    });
-  }
+  workers.reserve(threads - 1);
+  for (int t = 1; t < threads; ++t) workers.emplace_back(run, t);
+  run(0);
   for (auto& w : workers) w.join();
   if (first_error) std::rethrow_exception(first_error);
 }

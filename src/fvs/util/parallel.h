@@ -10,9 +10,9 @@ namespace fvs {
 // Number of worker threads: FVS_NUM_THREADS if set (>0), else the hardware concurrency.
 int DefaultNumThreads();
 
-// Calls fn(i) for i in [begin, end) on up to num_threads threads (<= 0: default), in
-// contiguous chunks. Exceptions thrown by fn are rethrown (the first one) after all
-// threads have joined.
+// Calls fn(i) for i in [begin, end) on up to num_threads threads (<= 0: default; the
+// calling thread is one of them), in contiguous chunks. Exceptions thrown by fn are
+// rethrown (the first one) after all threads have joined.
 void ParallelFor(int64_t begin, int64_t end, const std::function<void(int64_t)>& fn,
                  int num_threads = 0);
 
