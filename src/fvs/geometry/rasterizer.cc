@@ -207,8 +207,8 @@ void Rasterizer::RasterizeTriangle(int32_t face, int64_t x0, int64_t y0, int64_t
     const uint32_t row_bits = (1u << (px1 - px0 + 1)) - 1;
     uint32_t mask = 0;
 #if defined(__SSE2__)
-    // Two columns per 128-bit lane pair; the sign bits of the OR of the three edge
-    // functions are the pixels outside.
+    // Two columns per 128-bit vector of int64 (exact, as in the scalar code below); the
+    // sign bits of the OR of the three edge functions mark the pixels outside.
     using V2 = int64_t __attribute__((vector_size(16)));
     V2 left[3], right[3], down[3];
     for (int i = 0; i < 3; ++i) {
