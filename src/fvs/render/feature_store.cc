@@ -115,9 +115,12 @@ void FeatureStore::Prune(const std::string& keep) const {
   for (auto it = std::filesystem::recursive_directory_iterator(dir_, ec);
        !ec && it != std::filesystem::recursive_directory_iterator(); it.increment(ec)) {
     if (!it->is_regular_file(ec) || it->path().extension() != ".safetensors") continue;
-    Stored f{it->last_write_time(ec), it->path().string(),
-             static_cast<int64_t>(it->file_size(ec))};
-    if (ec) continue;  // removed meanwhile (another process pruning)
+    // Either query fails when the file was removed meanwhile (another process pruning);
+    // each is checked, as a later success clears the error code.
+    Stored f{it->last_write_time(ec), it->path().string(), 0};
+    if (ec) continue;
+    f.bytes = static_cast<int64_t>(it->file_size(ec));
+    if (ec) continue;
     total += f.bytes;
     if (f.path != keep) files.push_back(std::move(f));
   }
