@@ -20,7 +20,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "fvs/util/string_util.h"
+#include "fvs/render/method.h"
 #include "ui/path_panel.h"
 #include "ui/result_panel.h"
 #include "ui/scene_view.h"
@@ -376,7 +376,7 @@ RenderRequest MainWindow::CurrentRequest() const {
   request.height = height_->value();
   request.model_path = model_path_->text().trimmed().toStdString();
   if (contents_ && MethodNeedsWeights(request.method)) {
-    request.feature_cache_dir = JoinPaths(contents_->path, "fvs/features");
+    request.feature_cache_dir = WorkspaceFeatureCacheDir(contents_->path);
   }
   return request;
 }

@@ -258,7 +258,7 @@ int RunViewSynthesis(int argc, char** argv) {
                      "jobs; file names stay those of the full path)");
   if (!options.Parse(argc, argv)) return 0;
   if (o.disk_feature_cache) {
-    o.render.feature_cache_dir = JoinPaths(o.workspace_path, "fvs/features");
+    o.render.feature_cache_dir = WorkspaceFeatureCacheDir(o.workspace_path);
   }
   if (o.stable_sources) {
     if (o.render.source_hysteresis == 0) o.render.source_hysteresis = 0.1;

@@ -10,6 +10,7 @@
 #include "fvs/util/error.h"
 #include "fvs/util/hole_filling.h"
 #include "fvs/util/progress.h"
+#include "fvs/util/string_util.h"
 
 namespace fvs {
 
@@ -102,6 +103,10 @@ std::vector<std::string> RegisteredMethods() {
   std::vector<std::string> names;
   for (const auto& [name, factory] : registry.factories) names.push_back(name);
   return names;
+}
+
+std::string WorkspaceFeatureCacheDir(const std::string& workspace_path) {
+  return JoinPaths(workspace_path, "fvs/features");
 }
 
 std::unique_ptr<Method> CreateMethod(const std::string& name,

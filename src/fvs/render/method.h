@@ -67,8 +67,8 @@ struct RenderOptions {
   // source photo, weights and precision; render/feature_store.h), so that another run
   // reads them instead of encoding. As large as the photos' features (64 channels of
   // fp32: 79 MB for a 640x480 photo). Empty = memory only. view_synthesis
-  // --disk_feature_cache 1 uses W/fvs/features. The folder is kept within
-  // feature_cache_disk_mb (least recently used files removed first).
+  // --disk_feature_cache 1 and the GUI use WorkspaceFeatureCacheDir(W). The folder is
+  // kept within feature_cache_disk_mb (least recently used files removed first).
   std::string feature_cache_dir;
   int feature_cache_disk_mb = 8192;
   // Network methods: a target wider or taller than tile_size pixels is blended in tiles
@@ -115,6 +115,10 @@ using MethodFactory = std::function<std::unique_ptr<Method>(const RenderOptions&
 void RegisterMethod(const std::string& name, MethodFactory factory);
 // Names of the available methods, sorted; `ulr` and `nearest` are always there.
 std::vector<std::string> RegisteredMethods();
+// A workspace's folder for encoded source features (RenderOptions::feature_cache_dir):
+// W/fvs/features.
+std::string WorkspaceFeatureCacheDir(const std::string& workspace_path);
+
 // Throws fvs::Error for an unknown name, or for `fvs` when the network is not available.
 std::unique_ptr<Method> CreateMethod(const std::string& name,
                                      const RenderOptions& options);
