@@ -235,6 +235,74 @@ TEST(FvsNetTest, RgbSkipStartsAsThePriorBlendOfTheWarpedSources) {
                Error);
 }
 
+TEST(FvsAggTest, StartsAsTheUlrBlendAndLearnsEverywhere) {
+  // fvs_agg untrained: zero confidence and colour heads and a zero residual, so it
+  // renders the ULR blend of the warped photos (black where a source does not see).
+  torch::manual_seed(4);
+  FvsNet net(ModelConfig::ForVariant("fvs_agg"));
+  EXPECT_EQ(net->config().EncodedChannels(), 3);
+  EXPECT_EQ(net->EncoderParameterCount(), 0);
+  EXPECT_DOUBLE_EQ(net->EncodeFlops(270, 480), 0.0);
+  EXPECT_GT(net->BlendFlops(270, 480), 0.0);
+  net->eval();
+  const Inputs in = MakeInputs(4, 17, 23);
+  {
+    torch::NoGradGuard no_grad;
+    EXPECT_TRUE(torch::equal(net->Encode(in.images), in.images));
+    const torch::Tensor warped_rgb = torch::where(
+        in.valid_warp > 0.5, WarpFeatures(in.images, in.grid), torch::full({1}, -1.0f));
+    const torch::Tensor w = torch::exp(net->config().ulr_prior * in.ulr);
+    const torch::Tensor expected =
+        ((w * warped_rgb).sum(0, true) / w.sum(0, true)).clamp(-1, 1);
+    const BlendOutput out =
+        net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp, in.ulr);
+    EXPECT_LT((out.rgb - expected).abs().max().item<float>(), 1e-5f);
+    // Without its prior it refuses to run.
+    EXPECT_THROW(net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp), Error);
+  }
+  // Every parameter gets a finite gradient, K = 1 included.
+  for (int k : {1, 3}) {
+    net->train();
+    net->zero_grad();
+    const Inputs x = MakeInputs(k, 16, 21, 20, 28);
+    const BlendOutput out =
+        net->Forward(x.images, x.grid, x.valid_depth, x.valid_warp, x.ulr);
+    (out.rgb - 0.5).abs().mean().backward();
+    for (const auto& p : net->named_parameters()) {
+      ASSERT_TRUE(p.value().grad().defined()) << p.key();
+      EXPECT_TRUE(torch::isfinite(p.value().grad()).all().item<bool>()) << p.key();
+    }
+  }
+  // Bad layouts are refused with a reason.
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_agg","encoder_channels":[8,16]})"),
+               Error);
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_agg","ulr_prior":0})"), Error);
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_agg","blend_channels":[8]})"),
+               Error);
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs","blender":"mlp"})"), Error);
+}
+
+TEST(FvsAggTest, ExtremeInputsStayFinite) {
+  torch::manual_seed(5);
+  FvsNet net(ModelConfig::ForVariant("fvs_agg"));
+  // Random (not zero) heads, so the extreme inputs reach the blend.
+  {
+    torch::NoGradGuard no_grad;
+    for (auto& p : net->parameters()) p.normal_(0, 0.5);
+  }
+  net->eval();
+  torch::NoGradGuard no_grad;
+  const float inf = std::numeric_limits<float>::infinity();
+  Inputs in = MakeInputs(3, 12, 14);
+  in.ulr.fill_(-1e30f);
+  in.ulr[0].fill_(inf);
+  in.valid_warp.zero_();  // no source sees anything
+  const BlendOutput out =
+      net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp, in.ulr);
+  EXPECT_TRUE(torch::isfinite(out.rgb).all().item<bool>());
+  EXPECT_LE(out.rgb.abs().max().item<float>(), 1.0f);
+}
+
 TEST(SoftmaxWeightsTest, FiniteAndNormalisedAtExtremes) {
   const float inf = std::numeric_limits<float>::infinity();
   const float nan = std::numeric_limits<float>::quiet_NaN();

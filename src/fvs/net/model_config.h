@@ -10,8 +10,13 @@
 namespace fvs {
 
 struct ModelConfig {
-  // fvs | fvs_nogru | fvs_nomasks | fvs_noinfdepth | fvs_single | fvs_fast
+  // fvs | fvs_nogru | fvs_nomasks | fvs_noinfdepth | fvs_single | fvs_fast | fvs_agg
   std::string variant = "fvs";
+  // "unet": the paper's recurrent blending U-Net over encoded features. "aggregate":
+  // no encoder, per-pixel statistics across the warped photos and narrow convs
+  // (net/aggregate.h); needs encoder_channels empty, feature_channels 0, rgb_skip,
+  // use_masks, soft_argmax, ulr_prior > 0, no GRU and two blend_channels (w0, w1).
+  std::string blender = "unet";
   // Encoder output = warped feature channels per source.
   int feature_channels = 64;
   // Valid-depth and valid-warp masks appended to the warped features (66 channels in).
@@ -25,6 +30,7 @@ struct ModelConfig {
   // 0/invalid.
   bool inf_depth = true;
   // Encoder: VGG16 stage widths and conv counts (stages 1-3); decoder mirrors the widths.
+  // Empty: no encoder (the photos' colours are warped as they are).
   std::vector<int> encoder_channels = {64, 128, 256};
   std::vector<int> encoder_convs = {2, 2, 3};
   // Blending U-Net: widths of the encoder levels (the decoder mirrors all but the
@@ -63,13 +69,17 @@ struct ModelConfig {
 
   // Throws fvs::Error("model config", ...) when the numbers cannot make a network.
   void Check() const;
+  // The part of Check() for the "unet" blender (encoder and U-Net layout).
+  void CheckUnet() const;
 
   // Channels of Encode's output (and of the warped features) per source.
   int EncodedChannels() const { return feature_channels + (rgb_skip ? 3 : 0); }
   // Input channels of the blending net per source.
   int BlendInputChannels() const { return EncodedChannels() + (use_masks ? 2 : 0); }
   // Input sizes are padded to a multiple of these (total down-sampling of the U-Nets).
-  int EncoderStride() const { return 1 << (encoder_channels.size() - 1); }
+  int EncoderStride() const {
+    return encoder_channels.empty() ? 1 : 1 << (encoder_channels.size() - 1);
+  }
   int BlendStride() const { return 1 << (blend_channels.size() - 1); }
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "fvs/net/aggregate.h"
 #include "fvs/util/error.h"
 #include "fvs/util/parallel.h"
 
@@ -130,6 +131,13 @@ std::vector<const ConvUnitImpl*> ConvGruImpl::Units() const {
 
 FvsNetImpl::FvsNetImpl(const ModelConfig& config) : config_(config) {
   config_.Check();
+  if (config_.blender == "aggregate") {
+    aggregate_ = register_module("aggregate", std::make_shared<AggregateBlenderImpl>(config_));
+    for (const ConvUnitImpl* u : aggregate_->PerSourceUnits()) blend_units_.push_back(u);
+    // Counted per source although it runs once per target (an upper bound for K > 1).
+    for (const ConvUnitImpl* u : aggregate_->PerTargetUnits()) blend_units_.push_back(u);
+    return;
+  }
   const bool sep = config_.depthwise_separable;
 
   // Encoder: VGG-like down stages (average pooling between), U-Net decoder with two convs
@@ -212,6 +220,8 @@ torch::Tensor FvsNetImpl::Encode(const torch::Tensor& images) {
   Require(images.dim() == 4 && images.size(1) == 3 && images.size(2) > 0 &&
               images.size(3) > 0,
           kSubject, "Encode expects images [K,3,H,W], got " + Shape(images));
+  // No encoder: the blender works on the photos' own colours.
+  if (config_.encoder_channels.empty()) return images;
   const int64_t height = images.size(2), width = images.size(3);
   torch::Tensor x = PadTo(images, config_.EncoderStride(), /*replicate=*/true);
   std::vector<torch::Tensor> skips;
@@ -285,6 +295,13 @@ BlendOutput FvsNetImpl::Blend(const torch::Tensor& warped,
             "Blend expects ULR log-weights [" + std::to_string(k) + ",1," +
                 std::to_string(height) + "," + std::to_string(width) + "], got " +
                 Shape(ulr_log_weights));
+  }
+  if (aggregate_) {
+    BlendOutput out = aggregate_->forward(warped, valid_depth, valid_warp, ulr_log_weights);
+    if (!is_training()) {
+      out.rgb = torch::nan_to_num(out.rgb, 0.0, 1.0, -1.0).clamp(-1.0, 1.0);
+    }
+    return out;
   }
   // The input of sources [first, first + count): features + masks, padded. Built per
   // source in the recurrent case so that the full [K,66,H,W] never exists beside
@@ -395,6 +412,7 @@ double FvsNetImpl::EncodeFlops(int height, int width) const {
 double FvsNetImpl::BlendFlops(int height, int width) const {
   const int stride = config_.BlendStride();
   const int64_t ph = RoundUp(height, stride), pw = RoundUp(width, stride);
+  if (aggregate_) return FlopsAt(blend_units_, ph, pw);
   const int heads = config_.soft_argmax ? 4 : 3;  // 1x1 convs: RGB (+ confidence)
   return FlopsAt(blend_units_, ph, pw) +
          2.0 * heads * config_.blend_channels[0] * static_cast<double>(height) * width;

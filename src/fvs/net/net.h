@@ -20,6 +20,7 @@
 namespace fvs {
 
 struct SafeTensorsFile;
+class AggregateBlenderImpl;
 
 // LibTorch uses one thread here unless told; use fvs::DefaultNumThreads()
 // (FVS_NUM_THREADS).
@@ -102,6 +103,8 @@ class FvsNetImpl : public torch::nn::Module {
   };
   std::vector<Stage> blend_stages_;
   torch::nn::Conv2d rgb_head_{nullptr}, confidence_head_{nullptr};
+  // The whole blender of ModelConfig::blender == "aggregate" (net/aggregate.h).
+  std::shared_ptr<AggregateBlenderImpl> aggregate_;
   std::vector<const ConvUnitImpl*> encoder_units_, blend_units_;
 };
 TORCH_MODULE(FvsNet);

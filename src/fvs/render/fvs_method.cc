@@ -105,7 +105,8 @@ class FvsMethod : public Method {
     for (auto& p : net_->parameters()) {
       if (p.dim() == 4) p.set_data(p.contiguous(torch::MemoryFormat::ChannelsLast));
     }
-    if (!options_.feature_cache_dir.empty()) {
+    // A network without an encoder (fvs_agg) warps the photos themselves: nothing to keep.
+    if (!options_.feature_cache_dir.empty() && !config_.encoder_channels.empty()) {
       try {  // an optimisation: a read-only workspace renders, only slower
         store_ = std::make_unique<FeatureStore>(
             options_.feature_cache_dir, options_.model_path, config_.variant,

@@ -6,7 +6,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "fvs/net/image_tensor.h"
 #include "fvs/util/error.h"
+#include "fvs/util/hole_filling.h"
 #include "fvs/util/safetensors.h"
 
 namespace fvs {
@@ -57,6 +59,17 @@ PackedScene LoadPackedScene(const std::string& folder) {
   }
   const int64_t n = static_cast<int64_t>(s.names.size());
   Require(n >= 1, path, "the scene has no views");
+  s.holdout.assign(n, false);
+  if (auto held = file.metadata.find("holdout"); held != file.metadata.end()) {
+    try {
+      for (const auto& h : nlohmann::json::parse(held->second)) {
+        const auto it = std::find(s.names.begin(), s.names.end(), h.get<std::string>());
+        if (it != s.names.end()) s.holdout[it - s.names.begin()] = true;
+      }
+    } catch (const std::exception&) {
+      throw Error(path, "the 'holdout' metadata is not a JSON list of strings");
+    }
+  }
   s.images =
       ToTensor(file, "images", SafeDtype::kU8, torch::kUInt8, {n, 3, -1, -1}, path);
   const int64_t h = s.images.size(2), w = s.images.size(3);
@@ -89,12 +102,34 @@ std::vector<int> SelectTrainingSources(const PackedScene& scene, int target, int
   const float* row = scene.overlap.data_ptr<float>() + static_cast<int64_t>(target) * n;
   std::vector<int> order;
   for (int j = 0; j < n; ++j) {
-    if (j != target && row[j] > 0) order.push_back(j);
+    if (j != target && row[j] > 0 && !scene.holdout[j]) order.push_back(j);
   }
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return row[a] > row[b]; });
   if (static_cast<int>(order.size()) > k) order.resize(k);
   return order;
+}
+
+std::vector<int> ValidationTargets(const PackedScene& scene, int count) {
+  std::vector<int> candidates;
+  for (int v = 0; v < scene.num_views(); ++v) {
+    if (!scene.holdout[v]) candidates.push_back(v);
+  }
+  const int n = static_cast<int>(candidates.size());
+  count = std::min(n, count);
+  std::vector<int> targets;
+  for (int i = 0; i < count; ++i) {
+    targets.push_back(candidates[static_cast<int64_t>(i) * n / count]);
+  }
+  return targets;
+}
+
+torch::Tensor FillHolesOf(const torch::Tensor& rgb, const torch::Tensor& covered,
+                          const torch::Tensor& surface) {
+  Image color = TensorToImage(rgb);
+  const Image depth = TensorToImage(surface);
+  FillHoles(TensorToImage(covered), &depth, &color);
+  return ImageToTensor(color).to(rgb.device());
 }
 
 TrainingWarp ComputeTrainingWarp(
@@ -322,7 +357,7 @@ TrainingSampler::TrainingSampler(const std::vector<PackedScene>* scenes,
     : scenes_(scenes), options_(options), rng_(seed) {
   for (size_t s = 0; s < scenes->size(); ++s) {
     for (int v = 0; v < (*scenes)[s].num_views(); ++v) {
-      if (!SelectTrainingSources((*scenes)[s], v, 1).empty()) {
+      if (!(*scenes)[s].holdout[v] && !SelectTrainingSources((*scenes)[s], v, 1).empty()) {
         targets_.emplace_back(static_cast<int>(s), v);
       }
     }

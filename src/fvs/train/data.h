@@ -23,6 +23,9 @@ struct PackedScene {
   torch::Tensor depths;   // float [N,H,W], 0 = no surface
   torch::Tensor K, R, t;  // double [N,3,3], [N,3,3], [N,3]
   torch::Tensor overlap;  // float [N,N], diagonal 0
+  // Views held out of the geometry at prepare (the pack's "holdout" metadata): never a
+  // training or validation target, never a source.
+  std::vector<bool> holdout;
 
   int num_views() const { return static_cast<int>(names.size()); }
   int height() const { return static_cast<int>(images.size(2)); }
@@ -34,8 +37,12 @@ struct PackedScene {
 PackedScene LoadPackedScene(const std::string& folder);
 
 // Leave-one-out: the up to k views of highest overlap[target] (> 0 only), best first,
-// ties by index; never the target itself.
+// ties by index; never the target itself nor a held-out view.
 std::vector<int> SelectTrainingSources(const PackedScene& scene, int target, int k);
+
+// The validation targets of a scene: `count` views evenly spaced over those not held
+// out (fewer when the scene has fewer).
+std::vector<int> ValidationTargets(const PackedScene& scene, int count);
 
 struct WarpSettings {
   double occlusion_tolerance = 0.01;  // |z - D_source| <= tol * z
@@ -82,6 +89,11 @@ struct TrainingSample {
 TrainingSample MakeSample(const PackedScene& scene, int target,
                           const std::vector<int>& sources, int x0, int y0, int crop_width,
                           int crop_height, const WarpSettings& settings);
+
+// FillHoles (util/hole_filling.h) on a [1,3,H,W] image in [0,1], as the renderer fills
+// pixels no source sees; covered and surface are [1,1,H,W] (> 0 = yes).
+torch::Tensor FillHolesOf(const torch::Tensor& rgb, const torch::Tensor& covered,
+                          const torch::Tensor& surface);
 
 // Photometric augmentation, the same for the target and all its sources so that the
 // colours stay consistent across views (no geometric change: the cameras stay valid).

@@ -6,9 +6,11 @@
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "fvs/scene/scene.h"
 #include "fvs/scene/source_selection.h"
+#include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
 #include "fvs/util/parallel.h"
 #include "fvs/util/progress.h"
@@ -188,6 +190,17 @@ PackSummary PackScene(const Scene& scene, const PackOptions& options,
   file.Add(doubles("t", {n, 3}, t_values));
   file.metadata["fvs_pack_version"] = std::to_string(kPackFormatVersion);
   file.metadata["names"] = names.dump();
+  // Views held out of the geometry at prepare stay out of training and validation: they
+  // are the views view_synthesis_eval reports.
+  const std::string holdout_file = scene.workspace_path() + "/fvs/holdout.txt";
+  if (std::filesystem::is_regular_file(holdout_file)) {
+    nlohmann::json holdout = nlohmann::json::array();
+    std::istringstream lines(ReadFileToString(holdout_file));
+    for (std::string line; std::getline(lines, line);) {
+      if (!line.empty()) holdout.push_back(line);
+    }
+    file.metadata["holdout"] = holdout.dump();
+  }
   file.metadata["workspace"] = scene.workspace_path();
   file.metadata["scale"] = nlohmann::json(options.scale).dump();
   file.metadata["width"] = std::to_string(w);

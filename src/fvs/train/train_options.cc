@@ -64,6 +64,9 @@ std::vector<OptionSpec> Specs(TrainOptions* o) {
        "write model.safetensors in fp16"},
       {"Train.occlusion_tolerance", Kind::kDouble, &o->occlusion_tolerance, false,
        "relative depth tolerance of a valid warp"},
+      {"Train.headroom", Kind::kBool, &o->headroom, false,
+       "only measure ulr and the per-pixel and global oracles on the validation "
+       "views (M/headroom.csv), no training"},
       {"Train.num_threads", Kind::kInt, &o->num_threads, false,
        "LibTorch CPU threads (<= 0: FVS_NUM_THREADS or all cores)"},
   };

@@ -37,6 +37,9 @@ struct TrainOptions {
   double occlusion_tolerance = 0.01;  // warp validity, relative (reference: 1%)
   int num_threads = 0;                // CPU threads for LibTorch; <= 0: default
   bool quiet = false;                 // no progress lines (tests)
+  // Only measure the headroom of the validation scenes (train/headroom.h) into
+  // M/headroom.csv; no training.
+  bool headroom = false;
   // Tests: replaces the variant's layout with this JSON (ModelConfig::FromJson).
   std::string model_config_json;
 

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "fvs/net/image_tensor.h"
+#include "fvs/train/headroom.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
 #include "fvs/util/hole_filling.h"
@@ -83,15 +84,6 @@ DeviceSample ToDevice(const TrainingSample& s, const torch::Device& device) {
   auto to = [&](const torch::Tensor& t) { return t.defined() ? t.to(device) : t; };
   return {to(s.target_rgb),       to(s.source_rgb),      to(s.warp.grid),
           to(s.warp.valid_depth), to(s.warp.valid_warp), to(s.warp.ulr_log_weights)};
-}
-
-// FillHoles on a [1,3,H,W] image in [0,1]; covered and surface are [1,1,H,W] (> 0 = yes).
-torch::Tensor FillHolesOf(const torch::Tensor& rgb, const torch::Tensor& covered,
-                          const torch::Tensor& surface) {
-  Image color = TensorToImage(rgb);
-  const Image depth = TensorToImage(surface);
-  FillHoles(TensorToImage(covered), &depth, &color);
-  return ImageToTensor(color).to(rgb.device());
 }
 
 void SetUlrPrior(const ModelConfig& config, WarpSettings* warp) {
@@ -192,11 +184,9 @@ ValidationResult Trainer::Validate() {
   for (const PackedScene& scene : val_scenes_) {
     ValidationResult::Scene r;
     r.path = scene.path;
-    const int n = scene.num_views();
-    const int count = std::min(n, options_.val_views);
     double seconds = 0;
-    for (int i = 0; i < count; ++i) {
-      const int target = static_cast<int>(static_cast<int64_t>(i) * n / count);
+    // Held-out views (view_synthesis_eval's) are never validated on.
+    for (const int target : ValidationTargets(scene, options_.val_views)) {
       const auto sources = SelectTrainingSources(scene, target, options_.num_sources);
       if (sources.empty()) continue;
       const TrainingSample sample =
@@ -430,6 +420,39 @@ TrainSummary Trainer::Run() {
   return summary;
 }
 
-TrainSummary RunTraining(const TrainOptions& options) { return Trainer(options).Run(); }
+namespace {
+
+TrainSummary RunHeadroom(const TrainOptions& options) {
+  Require(!options.val_scene_list.empty(), "view_synthesis_train",
+          "--Train.headroom needs --val_scene_list");
+  Timer timer;
+  ConfigureTorchThreads();
+  if (options.num_threads > 0) torch::set_num_threads(options.num_threads);
+  const ModelConfig config = ModelConfig::ForVariant(options.variant);
+  WarpSettings warp;
+  warp.occlusion_tolerance = options.occlusion_tolerance;
+  warp.inf_depth = config.inf_depth;
+  SetUlrPrior(config, &warp);
+  const std::vector<HeadroomRow> rows =
+      MeasureHeadroom(LoadScenes(options.val_scene_list, 2, options.num_sources),
+                      options.num_sources, options.val_views, warp, {});
+  std::filesystem::create_directories(options.output_path);
+  WriteHeadroomCsv(options.output_path + "/headroom.csv", rows);
+  for (const HeadroomRow& r : rows) {
+    std::cout << r.scene << "  " << r.method << "  " << r.views << " views  PSNR "
+              << std::fixed << std::setprecision(2) << r.psnr << "  SSIM "
+              << std::setprecision(4) << r.ssim << "\n";
+  }
+  TrainSummary summary;
+  summary.seconds = timer.Seconds();
+  return summary;
+}
+
+}  // namespace
+
+TrainSummary RunTraining(const TrainOptions& options) {
+  if (options.headroom) return RunHeadroom(options);
+  return Trainer(options).Run();
+}
 
 }  // namespace fvs

@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# The CPU training run of fvs_agg (net/aggregate.h), spread over sessions: prepares the
+# scenes of ../shared/datasets (subsampled, stereo at 400 px), packs them at half size,
+# adds four generated scenes, and trains niced. Every stage skips what is done and the
+# trainer resumes from its newest checkpoint, so running this again continues the run.
+#   scripts/train_fvs_agg_cpu.sh [DATASETS_DIR] [WORK_DIR]
+# Validation scenes (never trained on): fox, middlebury_temple and monstree, prepared with
+# every 5th photo held out of the geometry (--holdout_images), the protocol of
+# view_synthesis_eval --protocol holdout; their packs are what the trainer validates on
+# (it skips the held-out views, which are kept for the reported evaluation).
+# FVS_TRAIN_STEPS (default 200000) and FVS_PREPARE_ONLY=1 steer it.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+DATASETS="$(realpath "${1:-../shared/datasets}")"
+WORK="${2:-/work/fvs_training}"
+NICE="${FVS_NICE:-19}"  # niceness of every stage
+COLMAP="$PWD/build/bin/colmap"
+[[ -x "$COLMAP" ]] || scripts/build.sh
+mkdir -p "$WORK"/{bin,images,ws,packed,runs}
+# A copy, so that rebuilding build/ never changes the binary under a running stage.
+cp "$COLMAP" "$WORK/bin/colmap"
+cd "$WORK"
+
+# scene:every n-th photo:holdout (1 = every 5th of the chosen photos held out).
+prepare_scene() {
+  local scene=$1 step=$2 holdout=$3 ws=ws/$1
+  [[ -f $ws/.done ]] && return 0
+  mkdir -p images/$scene
+  local i=0 j=0 held=()
+  for f in $(ls "$DATASETS/$scene/images" | sort); do
+    if (( i % step == 0 )); then
+      ln -sf "$DATASETS/$scene/images/$f" images/$scene/$f
+      (( holdout && j % 5 == 0 )) && held+=("$f")
+      j=$((j + 1))
+    fi
+    i=$((i + 1))
+  done
+  local args=()
+  if (( holdout )); then
+    printf "%s\n" "${held[@]}" > images/$scene.holdout.txt
+    args=(--holdout_images images/$scene.holdout.txt)
+  fi
+  echo "prepare $scene ($(ls images/$scene | wc -l) photos, ${#held[@]} held out)"
+  FVS_QUIET=1 nice -n "$NICE" bin/colmap view_synthesis_prepare --image_path images/$scene \
+    --workspace_path $ws --max_image_size 800 --Stereo.max_image_size 400 "${args[@]}" \
+    > prepare_$scene.log 2>&1 && touch $ws/.done || echo "  failed: see prepare_$scene.log"
+}
+
+pack_scene() {
+  local scene=$1
+  [[ -f ws/$scene/.done && ! -f packed/$scene/scene.safetensors ]] || return 0
+  FVS_QUIET=1 nice -n "$NICE" bin/colmap view_synthesis_pack --workspace_path ws/$scene \
+    --output_path packed/$scene --scale 0.5 > /dev/null
+}
+
+for seed in 11 12 13 14; do
+  [[ -f packed/synthetic_$seed/scene.safetensors ]] && continue
+  nice -n "$NICE" bin/colmap view_synthesis_synthetic --output_path ws/synthetic_$seed \
+    --SyntheticScene.num_views 30 --SyntheticScene.width 400 --SyntheticScene.height 300 \
+    --SyntheticScene.seed $seed --SyntheticScene.write_proxy_mesh 1 \
+    --SyntheticScene.path_step_degrees 8 > /dev/null
+  FVS_QUIET=1 nice -n "$NICE" bin/colmap view_synthesis_pack --workspace_path ws/synthetic_$seed \
+    --output_path packed/synthetic_$seed --scale 1 > /dev/null
+done
+
+# Validation first (small), then training scenes, smallest first.
+for spec in middlebury_temple:1:1 monstree:1:1 fox:2:1 sceaux_castle:1:0 \
+            middlebury_dino:2:0 beer:3:0 scodive:3:0 alexander:2:0 mary_rose:3:0 \
+            gold_cape:4:0 wall_clock:2:0; do
+  IFS=: read -r scene step holdout <<< "$spec"
+  prepare_scene "$scene" "$step" "$holdout"
+  pack_scene "$scene"
+done
+[[ "${FVS_PREPARE_ONLY:-0}" == "1" ]] && exit 0
+
+printf "packed/middlebury_temple\npacked/fox\npacked/monstree\n" > val.txt
+ls -d packed/*/ | sed 's#/$##' | grep -v -e middlebury_temple -e /fox -e /monstree > train.txt
+
+exec nice -n "$NICE" env FVS_NUM_THREADS="$(nproc)" bin/colmap view_synthesis_train \
+  --scene_list train.txt --val_scene_list val.txt --output_path runs/fvs_agg \
+  --Train.variant fvs_agg --Train.crop 128 --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
+  --Train.learning_rate 5e-4 --Train.val_every 500 --Train.val_views 3 \
+  --Train.log_every 50 --Train.checkpoint_minutes 10

@@ -1,0 +1,127 @@
+#include "fvs/train/headroom.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "fvs/net/net.h"
+#include "fvs/train/loss.h"
+#include "fvs/util/atomic_file.h"
+
+namespace fvs {
+namespace {
+
+double Psnr(const torch::Tensor& a, const torch::Tensor& b) {
+  const double mse = (a - b).pow(2).mean().item<double>();
+  return 10.0 * std::log10(1.0 / std::max(mse, 1e-10));
+}
+
+// Blend of colours [K,3,H,W] with weights [K,1,H,W] among the seeing sources.
+torch::Tensor WeightedBlend(const torch::Tensor& colours, const torch::Tensor& seen,
+                            const torch::Tensor& weights) {
+  const torch::Tensor w = weights * seen;
+  return (w * colours).sum(0, true) / w.sum(0, true).clamp_min(1e-12);
+}
+
+// Each pixel: the seeing source whose colour is closest (L1 over channels) to the photo.
+torch::Tensor PixelOracle(const torch::Tensor& colours, const torch::Tensor& seen,
+                          const torch::Tensor& photo) {
+  const torch::Tensor error =
+      (colours - photo).abs().sum(1, true) + (1 - seen) * 1e6;  // [K,1,H,W]
+  const torch::Tensor best = error.argmin(0, true);              // [1,1,H,W]
+  return colours.gather(0, best.expand({1, 3, -1, -1}));
+}
+
+// K global weights (softmax of free parameters) fitted to the photo on the covered pixels.
+torch::Tensor GlobalOracle(const torch::Tensor& colours, const torch::Tensor& seen,
+                           const torch::Tensor& photo, const torch::Tensor& covered) {
+  const int64_t k = colours.size(0);
+  torch::Tensor logits = torch::zeros({k, 1, 1, 1}, torch::requires_grad());
+  torch::optim::Adam adam({logits}, torch::optim::AdamOptions(0.1));
+  for (int i = 0; i < 150; ++i) {
+    adam.zero_grad();
+    const torch::Tensor blend = WeightedBlend(colours, seen, torch::softmax(logits, 0));
+    const torch::Tensor loss = ((blend - photo).pow(2) * covered).mean();
+    loss.backward();
+    adam.step();
+  }
+  torch::NoGradGuard no_grad;
+  return WeightedBlend(colours, seen, torch::softmax(logits, 0));
+}
+
+}  // namespace
+
+std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
+                                         int num_sources, int views_per_scene,
+                                         const WarpSettings& warp_settings,
+                                         const ImageDistance& lpips) {
+  const char* kMethods[] = {"ulr", "oracle_pixel", "oracle_global"};
+  std::vector<HeadroomRow> rows, all(3);
+  const double no_lpips = lpips ? 0.0 : -1.0;
+  for (int m = 0; m < 3; ++m) all[m] = {"all", kMethods[m], 0, 0, 0, no_lpips};
+  WarpSettings settings = warp_settings;
+  settings.ulr_log_weights = true;
+  for (const PackedScene& scene : scenes) {
+    std::vector<HeadroomRow> mine(3);
+    for (int m = 0; m < 3; ++m) mine[m] = {scene.path, kMethods[m], 0, 0, 0, no_lpips};
+    for (const int target : ValidationTargets(scene, views_per_scene)) {
+      const auto sources = SelectTrainingSources(scene, target, num_sources);
+      if (sources.empty()) continue;
+      const TrainingSample s = MakeSample(scene, target, sources, 0, 0, scene.width(),
+                                          scene.height(), settings);
+      const torch::Tensor colours = (WarpFeatures(s.source_rgb, s.warp.grid) + 1) * 0.5;
+      const torch::Tensor seen = s.warp.valid_warp;
+      const torch::Tensor covered = (seen.sum(0, true) > 0).to(torch::kFloat);
+      const torch::Tensor ulr = [&] {
+        torch::NoGradGuard no_grad;
+        return WeightedBlend(colours, seen, SoftmaxWeights(s.warp.ulr_log_weights));
+      }();
+      const torch::Tensor images[3] = {
+          ulr, PixelOracle(colours, seen, s.target_rgb),
+          GlobalOracle(colours, seen, s.target_rgb, covered)};
+      for (int m = 0; m < 3; ++m) {
+        torch::NoGradGuard no_grad;
+        const torch::Tensor filled =
+            FillHolesOf(images[m].clamp(0, 1), covered, s.warp.valid_depth);
+        HeadroomRow& r = mine[m];
+        r.psnr += Psnr(filled, s.target_rgb);
+        r.ssim += Ssim(filled, s.target_rgb).item<double>();
+        if (lpips) r.lpips += lpips(filled, s.target_rgb);
+        ++r.views;
+      }
+    }
+    for (int m = 0; m < 3; ++m) {
+      HeadroomRow& r = mine[m];
+      if (r.views == 0) continue;
+      all[m].views += r.views;
+      all[m].psnr += r.psnr;
+      all[m].ssim += r.ssim;
+      if (lpips) all[m].lpips += r.lpips;
+      r.psnr /= r.views;
+      r.ssim /= r.views;
+      if (lpips) r.lpips /= r.views;
+      rows.push_back(r);
+    }
+  }
+  for (HeadroomRow& r : all) {
+    if (r.views == 0) continue;
+    r.psnr /= r.views;
+    r.ssim /= r.views;
+    if (lpips) r.lpips /= r.views;
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+void WriteHeadroomCsv(const std::string& path, const std::vector<HeadroomRow>& rows) {
+  WriteFileAtomic(path, [&](std::ostream& out) {
+    out << "scene,method,views,psnr,ssim,lpips\n";
+    for (const HeadroomRow& r : rows) {
+      out << r.scene << "," << r.method << "," << r.views << "," << r.psnr << ","
+          << r.ssim << ",";
+      if (r.lpips >= 0) out << r.lpips;
+      out << "\n";
+    }
+  });
+}
+
+}  // namespace fvs

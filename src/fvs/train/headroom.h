@@ -1,0 +1,44 @@
+// Headroom of a blender with today's geometry, on packed validation scenes: what the
+// `ulr` blend renders, what a per-pixel oracle renders (each pixel takes the warped
+// source colour closest to the photo, among the K sources that see it), and the best
+// single global weighting of the sources per view (K non-negative weights for the whole
+// image, blended among the sources that see each pixel; fitted to the photo by Adam on
+// the mean squared error). Both oracles see the photo, so they bound what any blender of
+// these warps can reach: the per-pixel one shows the gain of a sharp per-pixel choice
+// (occlusion, misalignment), the global one how much a better choice of sources alone
+// gives. Pixels no source sees are filled as the renderer fills them, the same for all.
+#pragma once
+
+#include <torch/torch.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "fvs/train/data.h"
+
+namespace fvs {
+
+struct HeadroomRow {
+  std::string scene;
+  std::string method;  // ulr | oracle_pixel | oracle_global
+  int views = 0;
+  double psnr = 0, ssim = 0;
+  double lpips = -1;  // -1: no LPIPS function given
+};
+
+// Distance of two [1,3,H,W] images in [0,1] (LPIPS); empty = not measured.
+using ImageDistance = std::function<double(const torch::Tensor&, const torch::Tensor&)>;
+
+// The validation views of Trainer::Validate (evenly spaced, held-out views skipped,
+// top-K sources by overlap, full packed size), one row per scene and method, then the
+// means over all views (scene "all").
+std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
+                                         int num_sources, int views_per_scene,
+                                         const WarpSettings& warp,
+                                         const ImageDistance& lpips);
+
+// Writes the rows as CSV (scene,method,views,psnr,ssim,lpips), atomically.
+void WriteHeadroomCsv(const std::string& path, const std::vector<HeadroomRow>& rows);
+
+}  // namespace fvs
