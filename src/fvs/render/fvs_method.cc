@@ -3,9 +3,12 @@
 #include <torch/torch.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <list>
 #include <map>
+#include <vector>
 
 #include "fvs/net/image_tensor.h"
 #include "fvs/net/net.h"
@@ -268,12 +271,33 @@ class FvsMethod : public Method {
 
 }  // namespace
 
+std::string ShippedModelPath(const std::string& variant) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> folders;
+  if (const char* dir = std::getenv("FVS_MODEL_DIR"); dir && *dir) folders.push_back(dir);
+  std::error_code error;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", error);
+  if (!error) folders.push_back(exe.parent_path() / "../share/colmap-fvs/models");
+  folders.push_back(FVS_SOURCE_MODEL_DIR);
+  for (const fs::path& folder : folders) {
+    const fs::path file = folder / (variant + ".safetensors");
+    if (fs::is_regular_file(file, error)) return file.lexically_normal().string();
+  }
+  return "";
+}
+
 std::unique_ptr<Method> CreateFvsMethod(const std::string& requested,
-                                        const RenderOptions& options) {
+                                        const RenderOptions& options_in) {
+  RenderOptions options = options_in;
   if (options.model_path.empty()) {
-    throw Error("--method " + requested,
-                "method " + requested +
-                    " needs model weights: --model_path <weights.safetensors>");
+    options.model_path = ShippedModelPath(requested);
+    if (options.model_path.empty()) {
+      throw Error("--method " + requested,
+                  "method " + requested +
+                      " needs model weights: --model_path <weights.safetensors> (no "
+                      "shipped " + requested + " model found; models/README.md)");
+    }
+    std::cerr << "using the shipped model " << options.model_path << "\n";
   }
   ConfigureTorchThreads();
   const bool have_cuda = torch::cuda::is_available();

@@ -10,10 +10,16 @@
 
 namespace fvs {
 
-// Loads options.model_path (throws fvs::Error naming the file on missing or mismatched
-// weights). `requested` is the --method name: "fvs" accepts any variant, a variant name
-// must match the weights' config.
+// Loads options.model_path, or the shipped model of `requested` when none is given
+// (ShippedModelPath); throws fvs::Error naming the file on missing or mismatched weights.
+// `requested` is the --method name: "fvs" accepts any variant, a variant name must match
+// the weights' config.
 std::unique_ptr<Method> CreateFvsMethod(const std::string& requested,
                                         const RenderOptions& options);
+
+// The shipped weights of a variant, <variant>.safetensors, in the first folder that has
+// them: $FVS_MODEL_DIR, <executable>/../share/colmap-fvs/models (an installed tree), the
+// source tree's models/ (a build-tree binary). Empty when none has them.
+std::string ShippedModelPath(const std::string& variant);
 
 }  // namespace fvs
