@@ -16,6 +16,7 @@ namespace fvs::colmap {
 namespace {
 
 using fvs::testing::RunShell;
+using fvs::testing::ScopedEnv;
 using fvs::testing::TempDir;
 using fvs::testing::WriteTextFile;
 
@@ -27,32 +28,6 @@ void WriteScript(const std::string& path, const std::string& body) {
   WriteTextFile(path, "#!/bin/sh\n" + body);
   ::chmod(path.c_str(), 0755);
 }
-
-// Restores an environment variable when the test ends.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) {
-    const char* old = std::getenv(name);
-    had_ = old != nullptr;
-    if (had_) old_ = old;
-    if (value) {
-      ::setenv(name, value, 1);
-    } else {
-      ::unsetenv(name);
-    }
-  }
-  ~ScopedEnv() {
-    if (had_) {
-      ::setenv(name_.c_str(), old_.c_str(), 1);
-    } else {
-      ::unsetenv(name_.c_str());
-    }
-  }
-
- private:
-  std::string name_, old_;
-  bool had_ = false;
-};
 
 std::string ErrorOf(const std::function<void()>& fn) {
   try {

@@ -1,48 +1,25 @@
-// LPIPS from a safetensors file: the AlexNet and VGG16 layouts load from random weights
-// written here (the official weights are not shipped: their values are checked by the
-// conversion recipe of doc/evaluation.md, not here), the distance behaves as LPIPS must
-// (0 for identical images, symmetric, linear in the lin layers), and every problem with
-// the file makes LPIPS "not available" with the reason, never a number.
+// LPIPS from a safetensors file: the official weights (../shared/weights, never in the
+// repository; skipped, visibly, where absent) reproduce the lpips package's own example
+// distances; the AlexNet and VGG16 layouts load from random weights written here, the
+// distance behaves as LPIPS must (0 for identical images, symmetric, linear in the lin
+// layers), and every problem with the file makes LPIPS "not available" with the reason,
+// never a number.
 #include "fvs/eval/lpips.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 
-#include "fvs/util/safetensors.h"
+#include "colmap_ext/image_io.h"
+#include "net/lpips_fixture.h"
 #include "support/test_support.h"
 
 namespace fvs::eval {
 namespace {
 
-// Deterministic pseudo-random weights: He-like scale so that activations stay O(1).
-std::string WriteRandomLpips(const std::string& path, const std::string& network,
-                             float lin_scale = 1.0f, const std::string& skip = "") {
-  uint64_t state = 12345;
-  auto uniform = [&] {
-    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
-    return static_cast<float>((state >> 40) & 0xFFFFFF) / 16777216.0f;  // [0, 1)
-  };
-  SafeTensorsFile file;
-  for (const auto& [name, shape] : LpipsExpectedTensors(network)) {
-    if (name == skip) continue;
-    int64_t count = 1, fan_in = 1;
-    for (size_t i = 0; i < shape.size(); ++i) {
-      count *= shape[i];
-      if (i > 0) fan_in *= shape[i];
-    }
-    std::vector<float> values(count);
-    const bool lin = name.rfind("lin", 0) == 0;
-    const float scale = std::sqrt(6.0f / std::max<int64_t>(1, fan_in));
-    for (float& v : values) {
-      v = lin ? lin_scale * 0.1f * uniform() : (2 * uniform() - 1) * scale;
-    }
-    file.Add(SafeTensor::FromFloats(name, shape, values.data()));
-  }
-  WriteSafeTensors(path, file);
-  return path;
-}
+using testing::WriteRandomLpips;
 
 Image Pattern(int w, int h, double phase) {
   Image image(w, h, 3);
@@ -55,6 +32,28 @@ Image Pattern(int w, int h, double phase) {
     }
   }
   return image;
+}
+
+// The lpips package's test_network.py prints "Distances: (0.722, 0.138)" for these
+// images with lpips.LPIPS(net='alex'), v0.1 (/work/shared/weights/README.md).
+TEST(Lpips, OfficialExampleDistancesWithTheRealWeights) {
+  std::string why_skip;
+  const std::string weights =
+      testing::SharedFile("weights/lpips_alex.safetensors", &why_skip);
+  if (weights.empty()) GTEST_SKIP() << why_skip;
+  const std::string images = testing::SharedDir() + "/weights/lpips_test_images/";
+  std::string why_not, network;
+  const PerceptualDistance lpips = LoadLpips(weights, &why_not, &network);
+  ASSERT_TRUE(lpips) << why_not;
+  EXPECT_EQ(network, "alex");
+  const Image ref = colmap::ReadImage(images + "ex_ref.png");
+  const double d0 = lpips(ref, colmap::ReadImage(images + "ex_p0.png"));
+  const double d1 = lpips(ref, colmap::ReadImage(images + "ex_p1.png"));
+  std::printf("LPIPS alex, official example: ref-p0 %.4f (0.722), ref-p1 %.4f (0.138)\n",
+              d0, d1);
+  EXPECT_NEAR(d0, 0.722, 0.002);
+  EXPECT_NEAR(d1, 0.138, 0.002);
+  EXPECT_EQ(lpips(ref, ref), 0.0);
 }
 
 TEST(Lpips, BothNetworksLoadAndMeasure) {
@@ -86,7 +85,8 @@ TEST(Lpips, BadFilesAreNotAvailableWithTheReason) {
   testing::TempDir dir;
   std::string why_not;
   EXPECT_FALSE(LoadLpips("", &why_not));
-  EXPECT_EQ(why_not, "LPIPS: not available (no --lpips_path given)");
+  EXPECT_EQ(why_not,
+            "LPIPS: not available (no --lpips_path given, FVS_LPIPS_PATH not set)");
   EXPECT_FALSE(LoadLpips(dir / "missing.safetensors", &why_not));
   EXPECT_NE(why_not.find("missing.safetensors: no such file"), std::string::npos)
       << why_not;

@@ -2,7 +2,8 @@
 // (FrontDoorBinary()) on a workspace written by the test from an exact mesh: the reports
 // and their numbers, LPIPS reported as not available, bad input (a photo of the wrong
 // size, a target not in the model) beside views that are still evaluated, shards that
-// merge into the unsharded result, and a small sweep with its Pareto table and plot.
+// merge into the unsharded result, a small sweep with its Pareto table and plot, and
+// LPIPS weights taken from FVS_LPIPS_PATH unless --lpips_path names others.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -10,6 +11,7 @@
 
 #include "colmap_ext/image_io.h"
 #include "fvs/eval/report.h"
+#include "net/lpips_fixture.h"
 #include "scene/scene_fixture.h"
 #include "support/test_support.h"
 
@@ -28,8 +30,13 @@ class ViewSynthesisEvalTest : public ::testing::Test {
     testing::WriteTestWorkspace(ws_, testing::ArcViews(7, 80, 60),
                                 testing::MakeTestWorldMesh());
   }
-  int Eval(const std::string& args, const std::string& out, std::string* output) {
-    return RunShell("FVS_QUIET=1 FVS_NUM_THREADS=2 " + FrontDoorBinary() +
+  // `lpips_env`: the value of FVS_LPIPS_PATH for the run; unset when empty, so that a
+  // shell's default does not change the reports.
+  int Eval(const std::string& args, const std::string& out, std::string* output,
+           const std::string& lpips_env = "") {
+    const std::string env = lpips_env.empty() ? "env -u FVS_LPIPS_PATH "
+                                              : "env FVS_LPIPS_PATH=" + lpips_env + " ";
+    return RunShell(env + "FVS_QUIET=1 FVS_NUM_THREADS=2 " + FrontDoorBinary() +
                         " view_synthesis_eval --workspace_path " + ws_ +
                         " --output_path " + out + " " + args,
                     output);
@@ -149,6 +156,29 @@ TEST_F(ViewSynthesisEvalTest, BadViewsAreReportedAndTheOthersEvaluated) {
   EXPECT_NE(output.find("--shard"), std::string::npos) << output;
   EXPECT_NE(Eval("--method fvs", dir_ / "x", &output), 0);
   EXPECT_NE(output.find("--model_path"), std::string::npos) << output;
+}
+
+TEST_F(ViewSynthesisEvalTest, LpipsWeightsFromTheEnvironmentUnlessTheFlagNamesOthers) {
+  const std::string weights =
+      testing::WriteRandomLpips(dir_ / "lpips_alex.safetensors", "alex");
+  const std::string args = "--protocol indices --target_indices 3 --method ulr";
+  std::string output;
+  // The environment alone.
+  ASSERT_EQ(Eval(args, dir_ / "env", &output, weights), 0) << output;
+  auto rows = ByTarget(dir_ / "env/results.csv");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_GT(rows.at("view_003.png").lpips, 0.0);
+  EXPECT_NE(
+      ReadTextFile(dir_ / "env/results.md").find("LPIPS v0.1 (alex) from " + weights),
+      std::string::npos);
+  // The flag wins over an environment that names no file.
+  ASSERT_EQ(Eval(args + " --lpips_path " + weights, dir_ / "flag", &output,
+                 dir_ / "no_such_lpips.safetensors"),
+            0)
+      << output;
+  rows = ByTarget(dir_ / "flag/results.csv");
+  EXPECT_GT(rows.at("view_003.png").lpips, 0.0);
+  EXPECT_EQ(output.find("no_such_lpips"), std::string::npos) << output;
 }
 
 TEST_F(ViewSynthesisEvalTest, SweepWritesParetoTableAndPlot) {

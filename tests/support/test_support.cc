@@ -35,6 +35,39 @@ std::string RealColmapBinary() {
   return "/usr/bin/colmap";
 }
 
+ScopedEnv::ScopedEnv(const char* name, const char* value) : name_(name) {
+  const char* old = std::getenv(name);
+  had_ = old != nullptr;
+  if (had_) old_ = old;
+  if (value) {
+    ::setenv(name, value, 1);
+  } else {
+    ::unsetenv(name);
+  }
+}
+
+ScopedEnv::~ScopedEnv() {
+  if (had_) {
+    ::setenv(name_.c_str(), old_.c_str(), 1);
+  } else {
+    ::unsetenv(name_.c_str());
+  }
+}
+
+std::string SharedDir() {
+  if (const char* env = std::getenv("FVS_SHARED_DIR")) return env;
+  return FVS_SHARED_DIR;
+}
+
+std::string SharedFile(const std::string& relative, std::string* why_skip) {
+  const std::string path = SharedDir() + "/" + relative;
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(path, ec)) return path;
+  *why_skip =
+      path + " is absent (the shared data beside the checkout, or $FVS_SHARED_DIR)";
+  return "";
+}
+
 int RunShell(const std::string& command, std::string* output) {
   FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
   if (!pipe) return -1;

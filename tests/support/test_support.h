@@ -30,6 +30,27 @@ std::string FrontDoorBinary();
 // The real COLMAP: $FVS_COLMAP_BIN or `colmap` on the PATH (not our front door).
 std::string RealColmapBinary();
 
+// The shared data beside the checkout (../shared: weights/, datasets/; never copied into
+// the repository), or $FVS_SHARED_DIR when set. Tests that need a file from it skip,
+// visibly, when it is absent (SharedFile).
+std::string SharedDir();
+// SharedDir()/relative when that file exists, else "" and *why_skip says what is missing.
+std::string SharedFile(const std::string& relative, std::string* why_skip);
+
+// Sets (value) or unsets (nullptr) an environment variable and restores it when the
+// test ends.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value);
+  ~ScopedEnv();
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  std::string name_, old_;
+  bool had_ = false;
+};
+
 // Runs a shell command, returns its exit status; output goes to *output when given.
 int RunShell(const std::string& command, std::string* output = nullptr);
 

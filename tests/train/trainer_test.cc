@@ -1,7 +1,8 @@
 // The trainer end to end on a tiny packed scene and a tiny network: the loss goes down on
 // a fixed sample, a resumed run is bit-identical to an uninterrupted one, a corrupt
 // newest checkpoint falls back to the previous one, bad input gives clear errors, VGG19
-// weights load by name.
+// weights load by name, LPIPS weights make the loss L1 + LPIPS and add LPIPS columns to
+// the validation.
 #include "fvs/train/trainer.h"
 
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
 #include "fvs/util/safetensors.h"
+#include "net/lpips_fixture.h"
 #include "scene/scene_fixture.h"
 #include "support/test_support.h"
 
@@ -36,6 +38,8 @@ const char kTinyNetNoSkip[] =
 class TrainerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
+    // The runs below choose their LPIPS weights themselves, whatever the shell says.
+    ::unsetenv(kLpipsPathEnv);
     dir_ = new TempDir();
     const Scene scene = testing::MakeTestScene(6, 64, 48);
     PackOptions options;
@@ -76,7 +80,7 @@ TEST_F(TrainerTest, LossDecreasesOnAFixedSample) {
   warp.ulr_log_weights = true;  // the prior of fvs_fast
   const TrainingSample s =
       MakeSample(scene, 2, SelectTrainingSources(scene, 2, 2), 16, 8, 32, 32, warp);
-  TrainingLoss loss("", torch::kCPU);
+  TrainingLoss loss(LossOptions{}, torch::kCPU);
   auto train = [&](const char* config, double* first, double* last) {
     FvsNet net(ModelConfig::FromJson(config));
     torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(3e-3));
@@ -146,13 +150,17 @@ TEST_F(TrainerTest, ResumedRunIsBitIdenticalToAnUninterruptedOne) {
   EXPECT_GT(changed, 0);
   // Validation wrote its rows (two passes: step 2 and the end).
   const std::string csv = ReadFileToString(dir_->path() + "/straight/validation.csv");
-  EXPECT_NE(csv.find("step,scene,views,psnr,ssim,seconds_per_view,ulr_psnr,ulr_ssim\n"),
-            std::string::npos);
+  EXPECT_NE(
+      csv.find("step,scene,views,psnr,ssim,seconds_per_view,ulr_psnr,ulr_ssim,lpips,"
+               "ulr_lpips\n"),
+      std::string::npos);
   EXPECT_NE(csv.find("\n2,all,2,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",n/a,n/a\n"), std::string::npos) << "no LPIPS weights: " << csv;
   EXPECT_NE(csv.find("\n4,all,2,"), std::string::npos) << csv;
   const std::string card = ReadFileToString(dir_->path() + "/straight/model.json");
   EXPECT_NE(card.find("\"validation\""), std::string::npos);
   EXPECT_NE(card.find("\"steps\": 4"), std::string::npos);
+  EXPECT_NE(card.find("\"loss\": \"l1+ssim\""), std::string::npos) << card;
   // Only the newest two checkpoints are kept.
   const auto checkpoints = Trainer::ListCheckpoints(dir_->path() + "/straight");
   ASSERT_EQ(checkpoints.size(), 1u);  // a single one was written (at the end)
@@ -260,8 +268,11 @@ TEST_F(TrainerTest, PerceptualLossLoadsVgg19ByName) {
   }
   const std::string path = dir_->path() + "/vgg19.safetensors";
   WriteSafeTensors(path, file);
-  TrainingLoss loss(path, torch::kCPU);
-  EXPECT_TRUE(loss.perceptual());
+  LossOptions vgg;
+  vgg.kind = "l1+vgg19";
+  vgg.vgg19_path = path;
+  TrainingLoss loss(vgg, torch::kCPU);
+  EXPECT_EQ(loss.Name(), "l1+vgg19");
   const torch::Tensor a = torch::rand({1, 3, 32, 32});
   const torch::Tensor b = torch::rand({1, 3, 32, 32}).requires_grad_(true);
   EXPECT_NEAR(loss(a, a).second, 0.0, 1e-7);
@@ -276,12 +287,66 @@ TEST_F(TrainerTest, PerceptualLossLoadsVgg19ByName) {
   }
   WriteSafeTensors(dir_->path() + "/vgg_partial.safetensors", partial);
   try {
-    TrainingLoss bad(dir_->path() + "/vgg_partial.safetensors", torch::kCPU);
+    vgg.vgg19_path = dir_->path() + "/vgg_partial.safetensors";
+    TrainingLoss bad(vgg, torch::kCPU);
     FAIL() << "no error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("features.21.weight"), std::string::npos)
         << e.what();
   }
+}
+
+TEST_F(TrainerTest, LpipsWeightsMakeTheLossAndTheValidationColumns) {
+  const std::string weights =
+      testing::WriteRandomLpips(dir_->path() + "/lpips_alex.safetensors", "alex");
+  TrainOptions o = Options("lpips");
+  o.max_steps = 2;
+  o.val_scene_list = dir_->path() + "/val.txt";
+  o.val_views = 2;
+  // A file of an older run: its header gains the new columns, its row stays.
+  std::filesystem::create_directories(o.output_path);
+  testing::WriteTextFile(o.output_path + "/validation.csv",
+                         "step,scene,views,psnr,ssim,seconds_per_view,ulr_psnr,ulr_ssim\n"
+                         "0,all,2,20,0.8,0.1,20,0.8\n");
+  {
+    // From the environment, as a shell would set it (the flag is tested by eval).
+    testing::ScopedEnv env(kLpipsPathEnv, weights.c_str());
+    const ValidationResult v = Trainer(o).Validate();
+    EXPECT_TRUE(v.has_lpips);
+    EXPECT_GT(v.lpips, 0.0);
+    EXPECT_GT(v.ulr_lpips, 0.0);
+    RunTraining(o);
+  }
+  const std::string csv = ReadFileToString(o.output_path + "/validation.csv");
+  EXPECT_EQ(
+      csv.rfind("step,scene,views,psnr,ssim,seconds_per_view,ulr_psnr,ulr_ssim,lpips,"
+                "ulr_lpips\n0,all,2,20,0.8,0.1,20,0.8\n",
+                0),
+      0u)
+      << csv;
+  EXPECT_NE(csv.find("\n2,all,2,"), std::string::npos) << csv;
+  EXPECT_EQ(csv.find("n/a"), std::string::npos) << csv;
+  const std::string card = ReadFileToString(o.output_path + "/model.json");
+  EXPECT_NE(card.find("\"loss\": \"l1+lpips\""), std::string::npos) << card;
+  EXPECT_NE(card.find("\"lpips_weight\": 1.0"), std::string::npos) << card;
+  EXPECT_NE(card.find("\"ulr_lpips\""), std::string::npos) << card;
+
+  // Explicit choices: SSIM with the weights at hand; LPIPS without them is an error.
+  TrainOptions ssim = Options("lpips_ssim");
+  ssim.max_steps = 1;
+  ssim.lpips_path = weights;
+  ssim.loss = "l1+ssim";
+  RunTraining(ssim);
+  EXPECT_NE(
+      ReadFileToString(ssim.output_path + "/model.json").find("\"loss\": \"l1+ssim\""),
+      std::string::npos);
+  TrainOptions missing = Options("lpips_missing");
+  missing.lpips_path = dir_->path() + "/no_such_lpips.safetensors";
+  missing.loss = "l1+lpips";
+  testing::ExpectError([&] { Trainer trainer(missing); },
+                       {"no_such_lpips.safetensors", "no such file"});
+  missing.loss = "auto";  // the default goes on without LPIPS
+  EXPECT_EQ(Trainer(missing).Validate().has_lpips, false);
 }
 
 TEST_F(TrainerTest, StandaloneBinaryReportsBadListsWithTheLine) {

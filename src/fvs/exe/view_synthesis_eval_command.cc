@@ -4,7 +4,8 @@
 //   one configuration: --method, --model_path, --num_sources K, --scale s
 //   or --sweep 1: methods x K x scales x precisions (--sweep_* lists)
 //   --shard i/n: only every n-th target (merge with view_synthesis_eval_merge)
-//   --lpips_path: LPIPS weights (safetensors); without them LPIPS is "n/a"
+//   --lpips_path: LPIPS weights (safetensors; default $FVS_LPIPS_PATH); without them
+//                 LPIPS is "n/a"
 // Renders the protocol's targets at the photos' size, scores them against the photos and
 // writes O/results.csv, O/summary.csv, O/results.md, O/contact_sheet.png and, for more
 // than one configuration, O/error_vs_time.png. Bad views are reported in their rows and
@@ -133,7 +134,8 @@ int RunViewSynthesisEval(int argc, char** argv) {
                      "with view_synthesis_eval_merge)");
   options.AddDefault("lpips_path", &o.lpips_path,
                      "LPIPS weights, AlexNet or VGG16 (safetensors, see "
-                     "doc/evaluation.md); without them LPIPS is n/a");
+                     "doc/evaluation.md; default $FVS_LPIPS_PATH); without them LPIPS "
+                     "is n/a");
   options.AddDefault("time", &o.time,
                      "time of the Pareto front and the plot: wall, or cpu (CPU seconds "
                      "of all threads, steadier on a shared machine); both are reported");
@@ -176,14 +178,15 @@ int RunViewSynthesisEval(int argc, char** argv) {
     CreateMethod(o.config.method, render);  // throws for a method that cannot run
     configs.push_back(o.config);
   }
+  // The flag wins over the environment's default.
+  const std::string lpips_path = ResolveLpipsPath(o.lpips_path);
   std::string lpips_why_not, lpips_network;
-  run.lpips = LoadLpips(o.lpips_path, &lpips_why_not, &lpips_network);
+  run.lpips = LoadLpips(lpips_path, &lpips_why_not, &lpips_network);
   if (run.lpips) {
-    notes.push_back("LPIPS v0.1 (" + lpips_network + ") from " + o.lpips_path);
+    notes.push_back("LPIPS v0.1 (" + lpips_network + ") from " + lpips_path);
   } else {
     notes.push_back(lpips_why_not);
-    if (!o.lpips_path.empty())
-      std::fprintf(stderr, "WARNING: %s\n", lpips_why_not.c_str());
+    if (!lpips_path.empty()) std::fprintf(stderr, "WARNING: %s\n", lpips_why_not.c_str());
   }
 
   Scene scene = Scene::Load(o.workspace_path, {true, o.num_threads});

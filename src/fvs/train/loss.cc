@@ -136,29 +136,64 @@ std::vector<torch::Tensor> Vgg19FeaturesImpl::forward(const torch::Tensor& image
   return taps;
 }
 
-TrainingLoss::TrainingLoss(const std::string& vgg19_path, const torch::Device& device) {
-  if (vgg19_path.empty()) return;
-  vgg_ = Vgg19Features();
-  vgg_->Load(vgg19_path);
-  vgg_->to(device);
-  vgg_->eval();
+std::string ChooseLoss(const std::string& requested, bool have_vgg19, bool have_lpips) {
+  if (requested == "auto") {
+    return have_vgg19 ? "l1+vgg19" : have_lpips ? "l1+lpips" : "l1+ssim";
+  }
+  Require(requested != "l1+vgg19" || have_vgg19, "--Train.loss",
+          "l1+vgg19 needs --vgg19_path");
+  Require(requested != "l1+lpips" || have_lpips, "--Train.loss",
+          std::string("l1+lpips needs LPIPS weights (--lpips_path or ") + kLpipsPathEnv +
+              ")");
+  return requested;
+}
+
+TrainingLoss::TrainingLoss(const LossOptions& options, const torch::Device& device)
+    : options_(options) {
+  const std::string& kind = options_.kind;
+  Require(kind == "l1+ssim" || kind == "l1+lpips" || kind == "l1+vgg19", "TrainingLoss",
+          "unknown loss '" + kind + "'");
+  if (kind == "l1+vgg19") {
+    vgg_ = Vgg19Features();
+    vgg_->Load(options_.vgg19_path);
+    vgg_->to(device);
+    vgg_->eval();
+  }
+  if (kind == "l1+lpips") {
+    Require(!options_.lpips.is_empty(), "TrainingLoss", "l1+lpips without LPIPS weights");
+    options_.lpips->to(device);
+    options_.lpips->eval();
+  } else {
+    options_.lpips = nullptr;  // validation may hold it; the loss does not need it
+  }
+}
+
+std::string TrainingLoss::SecondTermName() const {
+  return Name() == "l1+lpips" ? "lpips" : Name() == "l1+vgg19" ? "vgg" : "1-ssim";
+}
+
+torch::Tensor TrainingLoss::SecondTerm(const torch::Tensor& prediction01,
+                                       const torch::Tensor& target01) {
+  if (Name() == "l1+lpips") {
+    return options_.lpips_weight * options_.lpips->forward(prediction01, target01).mean();
+  }
+  if (Name() == "l1+vgg19") {
+    const auto fp = vgg_->forward(prediction01);
+    const auto ft = vgg_->forward(target01);
+    torch::Tensor second = torch::zeros({}, prediction01.options());
+    for (size_t i = 0; i < fp.size(); ++i) {
+      second = second + kTapWeights[i] * (fp[i] - ft[i].detach()).abs().mean();
+    }
+    return second;
+  }
+  return 1.0 - Ssim(prediction01, target01);
 }
 
 LossValue TrainingLoss::operator()(const torch::Tensor& prediction01,
                                    const torch::Tensor& target01) {
   LossValue out;
   const torch::Tensor l1 = (prediction01 - target01).abs().mean();
-  torch::Tensor second;
-  if (perceptual()) {
-    const auto fp = vgg_->forward(prediction01);
-    const auto ft = vgg_->forward(target01);
-    second = torch::zeros({}, prediction01.options());
-    for (size_t i = 0; i < fp.size(); ++i) {
-      second = second + kTapWeights[i] * (fp[i] - ft[i].detach()).abs().mean();
-    }
-  } else {
-    second = 1.0 - Ssim(prediction01, target01);
-  }
+  const torch::Tensor second = SecondTerm(prediction01, target01);
   out.total = l1 + second;
   out.l1 = l1.item<double>();
   out.second = second.item<double>();

@@ -1,8 +1,10 @@
-// Training losses on images in [0, 1]:
-//   default      L1 + (1 - SSIM)  (SSIM with the 11x11 Gaussian window, sigma 1.5, valid
-//                                  region only: no zero padding at the borders)
-//   with VGG19   L1 + perceptual: L1 between VGG19 features at relu1_2, relu2_2, relu3_2,
-//                relu4_2, relu5_2 weighted 1, 0.75, 0.5, 0.5, 1 (Riegler & Koltun 2020).
+// Training losses on images in [0, 1] (ChooseLoss picks one):
+//   l1+ssim    L1 + (1 - SSIM)  (SSIM with the 11x11 Gaussian window, sigma 1.5, valid
+//                                region only: no zero padding at the borders)
+//   l1+lpips   L1 + w LPIPS-alex (net/lpips_net.h; w = --Train.lpips_weight, 1): the
+//              perceptual loss whose weights we have (../shared/weights/README.md)
+//   l1+vgg19   L1 + perceptual: L1 between VGG19 features at relu1_2, relu2_2, relu3_2,
+//              relu4_2, relu5_2 weighted 1, 0.75, 0.5, 0.5, 1 (Riegler & Koltun 2020).
 // VGG19 weights cannot be downloaded here, so they come from a safetensors file holding
 // torchvision's vgg19 `features` state dict (names "features.<i>.weight"/".bias", i = 0,
 // 2, 5, ..., 30; doc/training.md has the one-line conversion).
@@ -12,6 +14,8 @@
 
 #include <string>
 #include <vector>
+
+#include "fvs/net/lpips_net.h"
 
 namespace fvs {
 
@@ -36,20 +40,40 @@ class Vgg19FeaturesImpl : public torch::nn::Module {
 TORCH_MODULE(Vgg19Features);
 
 struct LossValue {
-  torch::Tensor total;  // differentiable scalar
+  torch::Tensor total;  // differentiable scalar: l1 + second
   double l1 = 0;
-  double second = 0;  // 1 - SSIM, or the perceptual term
+  double second = 0;  // 1 - SSIM, w x LPIPS, or the VGG19 term
+};
+
+// The loss of a run: `requested` (auto, l1+ssim, l1+lpips, l1+vgg19) made concrete.
+// auto: l1+vgg19 when a VGG19 file is given (asking for it is the stronger wish), else
+// l1+lpips when LPIPS weights are loaded, else l1+ssim. Throws fvs::Error when an
+// explicit choice lacks its weights.
+std::string ChooseLoss(const std::string& requested, bool have_vgg19, bool have_lpips);
+
+struct LossOptions {
+  std::string kind = "l1+ssim";  // l1+ssim, l1+lpips or l1+vgg19 (ChooseLoss)
+  std::string vgg19_path;        // l1+vgg19: the weights file
+  LpipsNet lpips{nullptr};       // l1+lpips: the loaded network (validation shares it)
+  double lpips_weight = 1.0;
 };
 
 class TrainingLoss {
  public:
-  // Empty vgg19_path: L1 + SSIM. Otherwise loads VGG19 onto `device`.
-  TrainingLoss(const std::string& vgg19_path, const torch::Device& device);
+  // Loads VGG19 (l1+vgg19) and moves the networks onto `device`. Throws fvs::Error for
+  // an unknown kind, a bad VGG19 file or l1+lpips without a network.
+  TrainingLoss(const LossOptions& options, const torch::Device& device);
+  // The mean over the batch of prediction and target, [B,3,H,W] in [0, 1].
   LossValue operator()(const torch::Tensor& prediction01, const torch::Tensor& target01);
-  bool perceptual() const { return !vgg_.is_empty(); }
-  std::string Name() const { return perceptual() ? "l1+vgg19" : "l1+ssim"; }
+  const std::string& Name() const { return options_.kind; }
+  // The second term in progress lines: "1-ssim", "lpips" or "vgg".
+  std::string SecondTermName() const;
 
  private:
+  torch::Tensor SecondTerm(const torch::Tensor& prediction01,
+                           const torch::Tensor& target01);
+
+  LossOptions options_;
   Vgg19Features vgg_{nullptr};
 };
 

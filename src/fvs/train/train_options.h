@@ -15,6 +15,12 @@ struct TrainOptions {
   std::string output_path;     // M/: checkpoints, validation.csv, model.safetensors
   std::string val_scene_list;  // optional: held-out scenes for validation
   std::string vgg19_path;      // optional: VGG19 safetensors -> L1 + perceptual loss
+  // Optional LPIPS weights (empty: $FVS_LPIPS_PATH, ResolveLpipsPath): validation reports
+  // LPIPS, and the default loss becomes L1 + LPIPS.
+  std::string lpips_path;
+  // auto | l1+ssim | l1+lpips | l1+vgg19 (ChooseLoss in train/loss.h).
+  std::string loss = "auto";
+  double lpips_weight = 1.0;  // of the LPIPS term of l1+lpips
   std::string variant = "fvs";
   std::string device = "auto";  // auto | cpu | cuda
   int max_steps = 100000;

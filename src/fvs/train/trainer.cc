@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "fvs/net/image_tensor.h"
+#include "fvs/net/lpips_weights.h"
 #include "fvs/train/headroom.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
@@ -92,6 +93,89 @@ void SetUlrPrior(const ModelConfig& config, WarpSettings* warp) {
   warp->ulr.resolution_weight = config.ulr_resolution_weight;
 }
 
+// PSNR, SSIM and (with LPIPS weights) LPIPS of a [1,3,H,W] image in [0, 1].
+struct ViewScores {
+  double psnr = 0, ssim = 0, lpips = 0;
+};
+ViewScores ScoreView(const torch::Tensor& image, const torch::Tensor& target,
+                     LpipsNet lpips) {
+  ViewScores scores;
+  const double mse = (image - target).pow(2).mean().item<double>();
+  scores.psnr = 10.0 * std::log10(1.0 / std::max(mse, 1e-10));
+  scores.ssim = Ssim(image, target).item<double>();
+  if (!lpips.is_empty()) scores.lpips = lpips->forward(image, target).item<double>();
+  return scores;
+}
+
+// The quality sums of a scene or of all scenes (ValidationResult and its Scene share
+// the field names).
+template <typename Sums>
+void DivideSums(int views, Sums* s) {
+  for (double* v :
+       {&s->psnr, &s->ssim, &s->lpips, &s->ulr_psnr, &s->ulr_ssim, &s->ulr_lpips}) {
+    *v /= views;
+  }
+}
+void AddSums(const ValidationResult::Scene& scene, ValidationResult* all) {
+  all->psnr += scene.psnr;
+  all->ssim += scene.ssim;
+  all->lpips += scene.lpips;
+  all->ulr_psnr += scene.ulr_psnr;
+  all->ulr_ssim += scene.ulr_ssim;
+  all->ulr_lpips += scene.ulr_lpips;
+}
+
+// M/validation.csv: the old rows and the new, written atomically.
+void AppendValidationCsv(const std::string& folder, int step, int total_views,
+                         const ValidationResult& result) {
+  std::filesystem::create_directories(folder);
+  const std::string csv = folder + "/validation.csv";
+  std::string text;
+  if (std::filesystem::exists(csv)) text = ReadFileToString(csv);
+  const std::string header =
+      "step,scene,views,psnr,ssim,seconds_per_view,ulr_psnr,ulr_ssim,lpips,ulr_lpips";
+  if (text.empty()) text = header + "\n";
+  // Files of older runs had fewer columns (no ULR, no LPIPS): the header names the
+  // newest layout, their rows keep theirs.
+  if (text.compare(0, header.size() + 1, header + "\n") != 0) {
+    text = header + text.substr(std::min(text.find('\n'), text.size()));
+  }
+  std::ostringstream rows;
+  rows << std::setprecision(6);
+  auto lpips = [&](double v) {
+    std::ostringstream s;
+    s << std::setprecision(6) << v;
+    return result.has_lpips ? s.str() : std::string("n/a");
+  };
+  for (const auto& r : result.scenes) {
+    rows << step << "," << r.path << "," << r.views << "," << r.psnr << "," << r.ssim
+         << "," << r.seconds_per_view << "," << r.ulr_psnr << "," << r.ulr_ssim << ","
+         << lpips(r.lpips) << "," << lpips(r.ulr_lpips) << "\n";
+  }
+  rows << step << ",all," << total_views << "," << result.psnr << "," << result.ssim
+       << "," << result.seconds_per_view << "," << result.ulr_psnr << ","
+       << result.ulr_ssim << "," << lpips(result.lpips) << "," << lpips(result.ulr_lpips)
+       << "\n";
+  text += rows.str();
+  WriteFileAtomic(csv, [&](std::ostream& out) { out << text; });
+}
+
+void PrintValidation(int step, int total_views, const ValidationResult& result) {
+  std::ostringstream net, ulr;
+  net << std::fixed << std::setprecision(2) << result.psnr << " dB, SSIM "
+      << std::setprecision(4) << result.ssim;
+  ulr << std::fixed << std::setprecision(2) << result.ulr_psnr << " dB, SSIM "
+      << std::setprecision(4) << result.ulr_ssim;
+  if (result.has_lpips) {
+    net << ", LPIPS " << result.lpips;
+    ulr << ", LPIPS " << result.ulr_lpips;
+  }
+  std::cerr << "[train] validation at step " << step << ": PSNR " << net.str() << ", "
+            << std::fixed << std::setprecision(3) << result.seconds_per_view
+            << " s/view (" << total_views
+            << " views); ulr on the same views: " << ulr.str() << "\n";
+}
+
 }  // namespace
 
 Trainer::Trainer(const TrainOptions& options) : options_(options) {
@@ -113,6 +197,9 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
              (options_.device == "auto" && torch::cuda::is_available()))
                 ? torch::Device(torch::kCUDA)
                 : torch::Device(torch::kCPU);
+
+  // Before the scenes: a bad weights file should not wait for them to load.
+  LoadLpipsWeights();
 
   const int k = options_.num_sources;
   train_scenes_ = LoadScenes(options_.scene_list, k + 1, k);
@@ -137,8 +224,32 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
   sampler_ = std::make_unique<TrainingSampler>(
       &train_scenes_, sampler,
       0x9E3779B97F4A7C15ULL ^ static_cast<uint64_t>(options_.seed));
-  loss_ = std::make_unique<TrainingLoss>(options_.vgg19_path, device_);
+  LossOptions loss;
+  loss.kind = ChooseLoss(options_.loss, !options_.vgg19_path.empty(), !lpips_.is_empty());
+  loss.vgg19_path = options_.vgg19_path;
+  loss.lpips = lpips_;
+  loss.lpips_weight = options_.lpips_weight;
+  loss_ = std::make_unique<TrainingLoss>(loss, device_);
   Resume();
+}
+
+void Trainer::LoadLpipsWeights() {
+  lpips_path_ = ResolveLpipsPath(options_.lpips_path);
+  if (lpips_path_.empty()) return;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(lpips_path_, ec)) {
+    // Asked for by name: an error. Only a default (auto, perhaps from the environment):
+    // the run goes on without LPIPS and says so.
+    Require(options_.loss != "l1+lpips", lpips_path_,
+            "no such file (the LPIPS weights of --Train.loss l1+lpips)");
+    std::cerr << "[train] WARNING: " << lpips_path_
+              << ": no such file; no LPIPS in the loss or the validation\n";
+    lpips_path_.clear();
+    return;
+  }
+  lpips_ = LpipsNet(lpips_path_);  // a file that is not LPIPS weights throws
+  lpips_->to(device_);
+  lpips_->eval();
 }
 
 LossValue Trainer::Step() {
@@ -173,6 +284,7 @@ LossValue Trainer::Step() {
 ValidationResult Trainer::Validate() {
   ValidationResult result;
   result.step = step_;
+  result.has_lpips = !lpips_.is_empty();
   torch::NoGradGuard no_grad;
   net_->eval();
   WarpSettings warp;
@@ -201,12 +313,6 @@ ValidationResult Trainer::Validate() {
           FillHolesOf(((out.rgb + 1.0) * 0.5).clamp(0.0, 1.0), covered, s.valid_depth);
       if (device_.is_cuda()) torch::cuda::synchronize();
       seconds += timer.Seconds();
-      auto psnr = [&](const torch::Tensor& image) {
-        const double mse = (image - s.target).pow(2).mean().item<double>();
-        return 10.0 * std::log10(1.0 / std::max(mse, 1e-10));
-      };
-      r.psnr += psnr(prediction);
-      r.ssim += Ssim(prediction, s.target).item<double>();
       const torch::Tensor ulr = FillHolesOf(
           (((SoftmaxWeights(s.ulr_log_weights) * WarpFeatures(s.sources, s.grid))
                 .sum(0, true) +
@@ -214,64 +320,31 @@ ValidationResult Trainer::Validate() {
            0.5)
               .clamp(0.0, 1.0),
           covered, s.valid_depth);
-      r.ulr_psnr += psnr(ulr);
-      r.ulr_ssim += Ssim(ulr, s.target).item<double>();
+      const ViewScores net = ScoreView(prediction, s.target, lpips_);
+      const ViewScores base = ScoreView(ulr, s.target, lpips_);
+      r.psnr += net.psnr;
+      r.ssim += net.ssim;
+      r.lpips += net.lpips;
+      r.ulr_psnr += base.psnr;
+      r.ulr_ssim += base.ssim;
+      r.ulr_lpips += base.lpips;
       ++r.views;
     }
     if (r.views == 0) continue;
-    result.psnr += r.psnr;
-    result.ssim += r.ssim;
-    result.ulr_psnr += r.ulr_psnr;
-    result.ulr_ssim += r.ulr_ssim;
+    AddSums(r, &result);
     result.seconds_per_view += seconds;
     total_views += r.views;
-    r.psnr /= r.views;
-    r.ssim /= r.views;
-    r.ulr_psnr /= r.views;
-    r.ulr_ssim /= r.views;
+    DivideSums(r.views, &r);
     r.seconds_per_view = seconds / r.views;
     result.scenes.push_back(r);
   }
   net_->train();
   if (total_views > 0) {
-    result.psnr /= total_views;
-    result.ssim /= total_views;
-    result.ulr_psnr /= total_views;
-    result.ulr_ssim /= total_views;
+    DivideSums(total_views, &result);
     result.seconds_per_view /= total_views;
   }
-  // validation.csv: append atomically (the old rows and the new, then rename).
-  std::filesystem::create_directories(options_.output_path);
-  const std::string csv = options_.output_path + "/validation.csv";
-  std::string text;
-  if (std::filesystem::exists(csv)) text = ReadFileToString(csv);
-  const std::string header =
-      "step,scene,views,psnr,ssim,seconds_per_view,ulr_psnr,ulr_ssim";
-  if (text.empty()) text = header + "\n";
-  // Files of older runs had no ULR columns: the header names the newest layout.
-  if (text.compare(0, header.size() + 1, header + "\n") != 0) {
-    text = header + text.substr(std::min(text.find('\n'), text.size()));
-  }
-  std::ostringstream rows;
-  rows << std::setprecision(6);
-  for (const auto& r : result.scenes) {
-    rows << step_ << "," << r.path << "," << r.views << "," << r.psnr << "," << r.ssim
-         << "," << r.seconds_per_view << "," << r.ulr_psnr << "," << r.ulr_ssim << "\n";
-  }
-  rows << step_ << ",all," << total_views << "," << result.psnr << "," << result.ssim
-       << "," << result.seconds_per_view << "," << result.ulr_psnr << ","
-       << result.ulr_ssim << "\n";
-  text += rows.str();
-  WriteFileAtomic(csv, [&](std::ostream& out) { out << text; });
-  if (!options_.quiet) {
-    std::cerr << "[train] validation at step " << step_ << ": PSNR " << std::fixed
-              << std::setprecision(2) << result.psnr << " dB, SSIM "
-              << std::setprecision(4) << result.ssim << ", " << std::setprecision(3)
-              << result.seconds_per_view << " s/view (" << total_views
-              << " views); ulr on the same views: " << std::setprecision(2)
-              << result.ulr_psnr << " dB, SSIM " << std::setprecision(4)
-              << result.ulr_ssim << "\n";
-  }
+  AppendValidationCsv(options_.output_path, step_, total_views, result);
+  if (!options_.quiet) PrintValidation(step_, total_views, result);
   last_validation_ = result;
   has_validation_ = true;
   return result;
@@ -297,6 +370,8 @@ std::string Trainer::SaveModel() {
   card["variant"] = config_.variant;
   card["config"] = nlohmann::json::parse(config_.ToJson());
   card["loss"] = loss_->Name();
+  if (loss_->Name() == "l1+lpips") card["lpips_weight"] = options_.lpips_weight;
+  if (!lpips_path_.empty()) card["lpips_weights"] = lpips_path_;
   card["steps"] = step_;
   card["batch_size"] = options_.batch_size;
   card["crop"] = options_.crop;
@@ -331,14 +406,23 @@ std::string Trainer::SaveModel() {
                         {"ulr_psnr", last_validation_.ulr_psnr},
                         {"ulr_ssim", last_validation_.ulr_ssim},
                         {"seconds_per_view", last_validation_.seconds_per_view}};
+    if (last_validation_.has_lpips) {
+      v["lpips"] = last_validation_.lpips;
+      v["ulr_lpips"] = last_validation_.ulr_lpips;
+    }
     for (const auto& r : last_validation_.scenes) {
-      v["scenes"].push_back({{"path", r.path},
-                             {"views", r.views},
-                             {"psnr", r.psnr},
-                             {"ssim", r.ssim},
-                             {"ulr_psnr", r.ulr_psnr},
-                             {"ulr_ssim", r.ulr_ssim},
-                             {"seconds_per_view", r.seconds_per_view}});
+      nlohmann::json scene = {{"path", r.path},
+                              {"views", r.views},
+                              {"psnr", r.psnr},
+                              {"ssim", r.ssim},
+                              {"ulr_psnr", r.ulr_psnr},
+                              {"ulr_ssim", r.ulr_ssim},
+                              {"seconds_per_view", r.seconds_per_view}};
+      if (last_validation_.has_lpips) {
+        scene["lpips"] = r.lpips;
+        scene["ulr_lpips"] = r.ulr_lpips;
+      }
+      v["scenes"].push_back(scene);
     }
     card["validation"] = v;
   }
@@ -377,9 +461,9 @@ TrainSummary Trainer::Run() {
         std::cerr << "[train] step " << step_ << "/" << options_.max_steps << "  loss "
                   << std::fixed << std::setprecision(4) << window_loss / window_steps
                   << " (l1 " << window_l1 / window_steps << ", "
-                  << (loss_->perceptual() ? "vgg " : "1-ssim ")
-                  << window_second / window_steps << ")  " << std::setprecision(2) << rate
-                  << " samples/s  ETA " << FormatDuration(eta) << "\n";
+                  << loss_->SecondTermName() << " " << window_second / window_steps
+                  << ")  " << std::setprecision(2) << rate << " samples/s  ETA "
+                  << FormatDuration(eta) << "\n";
       }
       window_loss = window_l1 = window_second = 0;
       window_steps = 0;
@@ -433,15 +517,27 @@ TrainSummary RunHeadroom(const TrainOptions& options) {
   warp.occlusion_tolerance = options.occlusion_tolerance;
   warp.inf_depth = config.inf_depth;
   SetUlrPrior(config, &warp);
+  ImageDistance distance;
+  const std::string lpips_path = ResolveLpipsPath(options.lpips_path);
+  if (!lpips_path.empty()) {
+    LpipsNet lpips(lpips_path);
+    lpips->eval();
+    distance = [lpips](const torch::Tensor& a, const torch::Tensor& b) mutable {
+      torch::NoGradGuard no_grad;
+      return lpips->forward(a, b).item<double>();
+    };
+  }
   const std::vector<HeadroomRow> rows =
       MeasureHeadroom(LoadScenes(options.val_scene_list, 2, options.num_sources),
-                      options.num_sources, options.val_views, warp, {});
+                      options.num_sources, options.val_views, warp, distance);
   std::filesystem::create_directories(options.output_path);
   WriteHeadroomCsv(options.output_path + "/headroom.csv", rows);
   for (const HeadroomRow& r : rows) {
     std::cout << r.scene << "  " << r.method << "  " << r.views << " views  PSNR "
               << std::fixed << std::setprecision(2) << r.psnr << "  SSIM "
-              << std::setprecision(4) << r.ssim << "\n";
+              << std::setprecision(4) << r.ssim;
+    if (r.lpips >= 0) std::cout << "  LPIPS " << r.lpips;
+    std::cout << "\n";
   }
   TrainSummary summary;
   summary.seconds = timer.Seconds();

@@ -3,7 +3,8 @@
 //                            the newest keep_checkpoints kept); the constructor resumes
 //                            from the newest one that loads, falling back past corrupt
 //                            ones
-//   M/validation.csv         step, scene, views, PSNR, SSIM, seconds per view
+//   M/validation.csv         step, scene, views, PSNR, SSIM, seconds per view, the same
+//                            of the ulr baseline, LPIPS of both (n/a without weights)
 //   M/model.safetensors      final weights (SaveWeights) and M/model.json, its card
 #pragma once
 
@@ -29,10 +30,13 @@ struct ValidationResult {
     // The `ulr` baseline on the same views, warps and masks (the ULR blend of the
     // warped sources, holes filled as the renderer fills them), for comparison.
     double ulr_psnr = 0, ulr_ssim = 0;
+    double lpips = 0, ulr_lpips = 0;  // meaningful when has_lpips
   };
   std::vector<Scene> scenes;
   double psnr = 0, ssim = 0, seconds_per_view = 0;  // means over all views
   double ulr_psnr = 0, ulr_ssim = 0;
+  double lpips = 0, ulr_lpips = 0;
+  bool has_lpips = false;  // LPIPS weights were given (--lpips_path, FVS_LPIPS_PATH)
 };
 
 class Trainer {
@@ -66,6 +70,8 @@ class Trainer {
  private:
   // Returns false (with the reason) when the file cannot be used.
   bool LoadCheckpoint(const std::string& path, std::string* why);
+  // LPIPS weights of --lpips_path or FVS_LPIPS_PATH, for the loss and the validation.
+  void LoadLpipsWeights();
   void Resume();
   std::string HardwareDescription() const;
 
@@ -77,6 +83,8 @@ class Trainer {
   std::unique_ptr<torch::optim::Adam> optimizer_;
   std::unique_ptr<TrainingSampler> sampler_;
   std::unique_ptr<TrainingLoss> loss_;
+  LpipsNet lpips_{nullptr};  // empty without weights
+  std::string lpips_path_;
   int step_ = 0;
   int resumed_from_ = -1;
   double train_seconds_ = 0;  // all invocations, for the card
