@@ -29,10 +29,12 @@ torch::Tensor UlrLogWeightTensor(const Scene& scene, const TargetView& target,
   const PinholeCamera& cam = target.camera;
   const int w = cam.width, h = cam.height;
   const int64_t num_pixels = static_cast<int64_t>(w) * h;
+  const UlrSources sources = MakeUlrSources(scene, target, prepared);
+  const double far_distance = UlrFarDistance(sources);
   std::vector<double> points(3 * num_pixels);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const Eigen::Vector3d p = UlrSurfacePoint(cam, depth, x, y);
+      const Eigen::Vector3d p = UlrSurfacePoint(cam, depth, x, y, far_distance);
       const int64_t i = static_cast<int64_t>(y) * w + x;
       for (int c = 0; c < 3; ++c) points[3 * i + c] = p[c];
     }
@@ -43,9 +45,8 @@ torch::Tensor UlrLogWeightTensor(const Scene& scene, const TargetView& target,
   UlrSettings settings;
   settings.num_blend = config.ulr_num_blend;
   settings.resolution_weight = config.ulr_resolution_weight;
-  UlrLogWeights(points.data(), num_pixels, MakeUlrSources(scene, target, prepared),
-                sees.data_ptr<float>(), settings, log_weights.data_ptr<float>(),
-                num_threads);
+  UlrLogWeights(points.data(), num_pixels, sources, sees.data_ptr<float>(), settings,
+                log_weights.data_ptr<float>(), num_threads);
   return log_weights.reshape({k, 1, h, w});
 }
 
