@@ -130,6 +130,7 @@ class FvsMethod : public Method {
     result.color = Image(w, h, 3, 0.0f);
     result.confidence = Image(w, h, 1, 0.0f);
     result.coverage = Image(w, h, 1, 0.0f);
+    result.infinity = Image(w, h, 1, 0.0f);
     const int k = static_cast<int>(prepared.sources.size());
     if (k == 0) return result;  // no source sees anything: black, coverage 0
 
@@ -200,6 +201,7 @@ class FvsMethod : public Method {
     // (TensorToImage brings any device and dtype to a float image on the CPU.)
     result.color = TensorToImage((rgb + 1.0) * 0.5);
     result.coverage = TensorToImage(warp_mask.sum(0, true) > 0);
+    result.infinity = AtInfinityMask(result.depth, result.coverage);
     result.confidence = have_weights ? TensorToImage(seen_weight) : result.coverage;
     result.timings.blend_s = timer.Seconds() - result.timings.encode_s;
     return result;

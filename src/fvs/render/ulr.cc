@@ -77,6 +77,7 @@ class UlrMethod : public Method {
         },
         options_.num_threads);
     result.depth = std::move(prepared.depth);
+    result.infinity = AtInfinityMask(result.depth, result.coverage);
     result.timings.blend_s = timer.Seconds();
     return result;
   }
