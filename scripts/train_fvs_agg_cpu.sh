@@ -15,6 +15,9 @@ DATASETS="$(realpath "${1:-../shared/datasets}")"
 WORK="${2:-/work/fvs_training}"
 NICE="${FVS_NICE:-19}"  # niceness of every stage
 COLMAP="$PWD/build/bin/colmap"
+# L1 + LPIPS-alex (the perceptual loss that can be had here) when the weights are there.
+LPIPS="${FVS_LPIPS_PATH:-$(realpath -m ../shared/weights/lpips_alex.safetensors)}"
+[[ -f "$LPIPS" ]] || LPIPS=""
 [[ -x "$COLMAP" ]] || scripts/build.sh
 mkdir -p "$WORK"/{bin,images,ws,packed,runs}
 # A copy, so that rebuilding build/ never changes the binary under a running stage.
@@ -64,9 +67,10 @@ for seed in 11 12 13 14; do
 done
 
 # Validation first (small), then training scenes, smallest first.
+# (middlebury_dino and wall_clock fail in the mapper with every 2nd photo; with all of
+# them they cost ~10 min each here: left out for now.)
 for spec in middlebury_temple:1:1 monstree:1:1 fox:2:1 sceaux_castle:1:0 \
-            middlebury_dino:2:0 beer:3:0 scodive:3:0 alexander:2:0 mary_rose:3:0 \
-            gold_cape:4:0 wall_clock:2:0; do
+            beer:3:0 scodive:3:0 alexander:2:0 mary_rose:3:0 gold_cape:4:0; do
   IFS=: read -r scene step holdout <<< "$spec"
   prepare_scene "$scene" "$step" "$holdout"
   pack_scene "$scene"
@@ -76,8 +80,9 @@ done
 printf "packed/middlebury_temple\npacked/fox\npacked/monstree\n" > val.txt
 ls -d packed/*/ | sed 's#/$##' | grep -v -e middlebury_temple -e /fox -e /monstree > train.txt
 
-exec nice -n "$NICE" env FVS_NUM_THREADS="$(nproc)" bin/colmap view_synthesis_train \
+exec nice -n "$NICE" env FVS_NUM_THREADS="$(nproc)" FVS_LPIPS_PATH="$LPIPS" \
+  bin/colmap view_synthesis_train \
   --scene_list train.txt --val_scene_list val.txt --output_path runs/fvs_agg \
   --Train.variant fvs_agg --Train.crop 128 --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
-  --Train.learning_rate 5e-4 --Train.val_every 500 --Train.val_views 3 \
-  --Train.log_every 50 --Train.checkpoint_minutes 10
+  --Train.batch_size 4 --Train.learning_rate 1e-3 --Train.val_every 250 \
+  --Train.val_views 4 --Train.log_every 25 --Train.checkpoint_minutes 10

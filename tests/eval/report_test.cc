@@ -130,6 +130,9 @@ TEST(Report, CsvRoundTripKeepsNotAvailableAndErrors) {
   rows[0].lpips = 0.123456;
   rows[0].config.scale = 0.5;
   rows[0].geometry_holdout = true;
+  rows[0].mesh_pixels = 0.625;
+  rows[0].infinity_pixels = 0.25;
+  rows[0].filled_pixels = 0.125;
   rows[1].error = "images/x.png: image is 4x4 but its camera is 8x6, \"bad\"";
   rows[1].psnr = rows[1].ssim = rows[1].seconds = rows[1].coverage = kNotAvailable;
   WriteResultsCsv(dir / "results.csv", rows);
@@ -141,6 +144,10 @@ TEST(Report, CsvRoundTripKeepsNotAvailableAndErrors) {
   EXPECT_DOUBLE_EQ(back[0].config.scale, 0.5);
   EXPECT_TRUE(back[0].geometry_holdout);
   EXPECT_EQ(back[0].config.Label(), rows[0].config.Label());
+  EXPECT_DOUBLE_EQ(back[0].mesh_pixels, 0.625);
+  EXPECT_DOUBLE_EQ(back[0].infinity_pixels, 0.25);
+  EXPECT_DOUBLE_EQ(back[0].filled_pixels, 0.125);
+  EXPECT_TRUE(std::isnan(back[1].infinity_pixels));
   EXPECT_EQ(back[1].target, rows[1].target);
   EXPECT_EQ(back[1].error, rows[1].error);
   EXPECT_FALSE(back[1].ok());
@@ -158,6 +165,26 @@ TEST(Report, CsvRoundTripKeepsNotAvailableAndErrors) {
   }
   testing::WriteTextFile(dir / "other.csv", "a,b\n1,2\n");
   EXPECT_THROW(ReadResultsCsv(dir / "other.csv"), Error);
+}
+
+// Files written before the pixel-origin columns (mesh, infinity, filled) still merge:
+// those three read as n/a.
+TEST(Report, ReadsResultsWithoutThePixelOriginColumns) {
+  testing::TempDir dir;
+  testing::WriteTextFile(
+      dir / "old.csv",
+      "scene,method,num_sources,scale,precision,protocol,target,geometry_holdout,status,"
+      "psnr,ssim,lpips,psnr_covered,ssim_covered,seconds,cpu_seconds,sources_used,"
+      "coverage,width,height,error\n"
+      "room,ulr,5,1,fp32,leave_one_out,a.png,no,ok,23.5,0.8,n/a,25,0.85,0.2,0.4,5,0.9,"
+      "8,6,\n");
+  const std::vector<ViewResult> rows = ReadResultsCsv(dir / "old.csv");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_DOUBLE_EQ(rows[0].coverage, 0.9);
+  EXPECT_EQ(rows[0].width, 8);
+  EXPECT_EQ(rows[0].height, 6);
+  EXPECT_TRUE(std::isnan(rows[0].mesh_pixels));
+  EXPECT_TRUE(std::isnan(rows[0].filled_pixels));
 }
 
 TEST(Sweep, PlansEveryCombinationAndSkipsNetworksWithoutWeights) {

@@ -71,6 +71,10 @@ TEST_F(ViewSynthesisEvalTest, LeaveOneOutReportsAndShardsMerge) {
     EXPECT_EQ(r.sources_used, 3) << name;
     EXPECT_TRUE(std::isnan(r.lpips)) << name;  // no weights: not available
     EXPECT_EQ(r.width, 80);
+    // The closed test room: every pixel has a surface, none comes from infinity.
+    EXPECT_NEAR(r.mesh_pixels + r.infinity_pixels + r.filled_pixels, 1.0, 2e-4) << name;
+    EXPECT_NEAR(r.mesh_pixels, r.coverage, 2e-4) << name;
+    EXPECT_EQ(r.infinity_pixels, 0.0) << name;
   }
   EXPECT_GT(rows.at("view_002.png").psnr, 25.0);  // inside the arc
   EXPECT_GT(rows.at("view_004.png").psnr, 25.0);

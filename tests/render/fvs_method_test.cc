@@ -15,6 +15,7 @@
 #include "fvs/render/method.h"
 #include "fvs/util/error.h"
 #include "fvs/util/safetensors.h"
+#include "render/render_fixture.h"
 #include "scene/scene_fixture.h"
 #include "support/test_support.h"
 
@@ -34,13 +35,7 @@ std::string SaveRandomModel(const std::string& dir, const std::string& variant,
   return path;
 }
 
-TargetView HeldOutTarget(const Scene& scene, int view) {
-  TargetView target;
-  target.name = "target";
-  target.camera = scene.view(view).camera;
-  target.exclude_views = {view};
-  return target;
-}
+using testing::HeldOutTarget;
 
 TEST(FvsMethod, FiniteDeterministicAndCached) {
   testing::TempDir dir;
@@ -168,16 +163,19 @@ TEST(FvsMethod, EveryVariantRendersFiniteImages) {
 
 // fvs_fast starts from the ULR blend (ModelConfig::ulr_prior, rgb_skip, zero heads): the
 // untrained network must render what the `ulr` method renders, black where no source sees
-// the pixel included. What remains is float rounding and the prior's floor
-// (kUlrWeightFloor).
+// the pixel included, and the background seen at infinity (the sky scene) too. What
+// remains is float rounding and the prior's floor (kUlrWeightFloor).
 TEST(FvsMethod, UntrainedFastNetworkRendersTheUlrBlend) {
   testing::TempDir dir;
-  const Scene scene = testing::MakeTestScene(6, 64, 48);
+  const Scene room = testing::MakeTestScene(6, 64, 48);
+  const Scene sky = testing::MakeTestSkyScene(6, 64, 48);
   RenderOptions options;
   options.num_sources = 4;
   options.model_path = SaveRandomModel(dir.path(), "fvs_fast");
-  for (const int view : {1, 3}) {
+  for (const auto& [scene_ptr, view] :
+       {std::make_pair(&room, 1), std::make_pair(&room, 3), std::make_pair(&sky, 2)}) {
     SCOPED_TRACE(view);
+    const Scene& scene = *scene_ptr;
     const TargetView target = HeldOutTarget(scene, view);
     const RenderResult net = CreateMethod("fvs", options)->Render(scene, target);
     const RenderResult ulr = CreateMethod("ulr", options)->Render(scene, target);
@@ -197,6 +195,12 @@ TEST(FvsMethod, UntrainedFastNetworkRendersTheUlrBlend) {
       close += diff < 1.0 / 255;
     }
     ASSERT_GT(covered, 1000);
+    EXPECT_EQ(net.infinity.data, ulr.infinity.data);
+    if (scene_ptr == &sky) {
+      int at_infinity = 0;
+      for (float v : ulr.infinity.data) at_infinity += v > 0;
+      EXPECT_GT(at_infinity, 500);
+    }
     const double pixels = static_cast<double>(ulr.coverage.data.size());
     EXPECT_LT(sum / pixels, 1e-3) << "worst " << worst;
     EXPECT_GT(close / pixels, 0.99) << "worst " << worst;

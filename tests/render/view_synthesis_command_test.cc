@@ -4,6 +4,7 @@
 // mesh, fvs without weights): one ERROR line and a non-zero exit.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -72,7 +73,8 @@ TEST_F(ViewSynthesisCommandTest, RendersHeldOutViewsWithExtras) {
   const std::string out = dir_ / "out";
   std::string output;
   ASSERT_EQ(Run("--target_images " + targets + " --output_path " + out +
-                    " --holdout 1 --write_depth 1 --write_confidence 1 --write_sources 1",
+                    " --holdout 1 --write_depth 1 --write_confidence 1 --write_sources 1"
+                    " --write_infinity 1",
                 &output),
             0)
       << output;
@@ -88,6 +90,10 @@ TEST_F(ViewSynthesisCommandTest, RendersHeldOutViewsWithExtras) {
     EXPECT_EQ(depth.width, 80);
     EXPECT_TRUE(fs::exists(stem + ".depth.png"));
     EXPECT_TRUE(fs::exists(stem + ".confidence.png"));
+    // The closed test room has a surface everywhere: nothing from infinity.
+    const Image infinity = colmap::ReadImage(stem + ".infinity.png");
+    EXPECT_EQ(infinity.width, 80);
+    EXPECT_EQ(*std::max_element(infinity.data.begin(), infinity.data.end()), 0.f);
     const auto json =
         nlohmann::json::parse(testing::ReadTextFile(stem + ".sources.json"));
     ASSERT_EQ(json["sources"].size(), 5u);

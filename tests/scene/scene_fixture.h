@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "colmap_ext/image_io.h"
@@ -98,6 +99,62 @@ inline Scene MakeTestScene(int num_views, int width, int height,
   Scene scene = Scene::FromWorld(views, mesh);
   for (int i = 0; i < num_views; ++i) {
     scene.SetSourceImage(i, RenderGroundTruth(mesh, views[i].camera));
+  }
+  return scene;
+}
+
+// An open world whose background lies beyond the proxy mesh: the floor and the box of
+// the test room are the mesh, the photos also show a textured "sky" box 500 units out
+// that the mesh does not have (as the sky or a far facade a real mesh never reaches).
+// The sky's colour pattern is that of a box of +-20 blown up 25 times, so it keeps a
+// period of about 0.15 rad (10 pixels at 96 x 72) and the cameras' baselines of about a
+// unit move it by under 0.2 pixels: it is at infinity for the renderers.
+inline TriangleMesh MakeTestFloorAndBoxMesh(double cell = 0.25) {
+  TriangleMesh mesh;
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  AddQuadGrid(&mesh, {-5, -4, 0}, {10, 0, 0}, {0, 8, 0}, 40, 32, zero);
+  const Eigen::Vector3d lo(-0.7, -0.5, 0), ex(1.4, 0, 0), ey(0, 1.0, 0), ez(0, 0, 1.2);
+  const int nx = std::lround(1.4 / cell), ny = std::lround(1.0 / cell),
+            nz = std::lround(1.2 / cell);
+  AddQuadGrid(&mesh, lo + ez, ex, ey, nx, ny, zero);
+  AddQuadGrid(&mesh, lo, ex, ez, nx, nz, zero);
+  AddQuadGrid(&mesh, lo + ey, ex, ez, nx, nz, zero);
+  AddQuadGrid(&mesh, lo, ey, ez, ny, nz, zero);
+  AddQuadGrid(&mesh, lo + ex, ey, ez, ny, nz, zero);
+  return mesh;
+}
+
+inline TriangleMesh MakeTestSkyMesh() {
+  TriangleMesh sky;
+  const double r = 20;
+  const Eigen::Vector3d lo(-r, -r, -r), zero = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d ex(2 * r, 0, 0), ey(0, 2 * r, 0), ez(0, 0, 2 * r);
+  const int n = 40;
+  for (const auto& [corner, u, v] :
+       {std::make_tuple(lo, ex, ey), std::make_tuple(Eigen::Vector3d(lo + ez), ex, ey),
+        std::make_tuple(lo, ex, ez), std::make_tuple(Eigen::Vector3d(lo + ey), ex, ez),
+        std::make_tuple(lo, ey, ez), std::make_tuple(Eigen::Vector3d(lo + ex), ey, ez)}) {
+    AddQuadGrid(&sky, corner, u, v, n, n, zero);
+  }
+  for (Eigen::Vector3d& p : sky.vertices) p *= 25.0;
+  return sky;
+}
+
+// The scene of n arc views (ArcViews) over the floor and box, photos with the sky.
+inline Scene MakeTestSkyScene(int num_views, int width, int height) {
+  const TriangleMesh proxy = MakeTestFloorAndBoxMesh();
+  TriangleMesh world = proxy;
+  const TriangleMesh sky = MakeTestSkyMesh();
+  const int base = static_cast<int>(world.vertices.size());
+  world.vertices.insert(world.vertices.end(), sky.vertices.begin(), sky.vertices.end());
+  world.colors.insert(world.colors.end(), sky.colors.begin(), sky.colors.end());
+  for (const Eigen::Vector3i& f : sky.faces) {
+    world.faces.push_back(f + Eigen::Vector3i::Constant(base));
+  }
+  const std::vector<SceneView> views = ArcViews(num_views, width, height);
+  Scene scene = Scene::FromWorld(views, proxy);
+  for (int i = 0; i < num_views; ++i) {
+    scene.SetSourceImage(i, RenderGroundTruth(world, views[i].camera));
   }
   return scene;
 }

@@ -42,19 +42,62 @@ struct Reference {
 
 // World point of the target pixel, projected by the absolute source pose, all long
 // double.
-Reference BruteForce(const PinholeCamera& t, double x, double y, double d,
-                     const PinholeCamera& s) {
-  const LMat Rt = t.R.cast<long double>(), Rs = s.R.cast<long double>();
-  const LVec tt = t.t.cast<long double>(), ts = s.t.cast<long double>();
-  const LVec xc((x + 0.5L - t.cx) / t.fx * d, (y + 0.5L - t.cy) / t.fy * d, d);
-  const LVec world = Rt.transpose() * (xc - tt);
-  const LVec xs = Rs * world + ts;
+// A point (or direction) in the source camera frame, projected.
+Reference ProjectReference(const LVec& xs, const PinholeCamera& s) {
   Reference r;
   r.z = xs.z();
   r.in_front = xs.z() > 0;
   r.u = s.fx * xs.x() / xs.z() + s.cx;
   r.v = s.fy * xs.y() / xs.z() + s.cy;
   return r;
+}
+
+Reference BruteForce(const PinholeCamera& t, double x, double y, double d,
+                     const PinholeCamera& s) {
+  const LMat Rt = t.R.cast<long double>(), Rs = s.R.cast<long double>();
+  const LVec tt = t.t.cast<long double>(), ts = s.t.cast<long double>();
+  const LVec xc((x + 0.5L - t.cx) / t.fx * d, (y + 0.5L - t.cy) / t.fy * d, d);
+  const LVec world = Rt.transpose() * (xc - tt);
+  return ProjectReference(Rs * world + ts, s);
+}
+
+// The direction of the target pixel's ray rotated into the source (no translation: a
+// point at infinity), projected, all long double.
+Reference BruteForceAtInfinity(const PinholeCamera& t, double x, double y,
+                               const PinholeCamera& s) {
+  const LMat Rt = t.R.cast<long double>(), Rs = s.R.cast<long double>();
+  const LVec ray((x + 0.5L - t.cx) / t.fx, (y + 0.5L - t.cy) / t.fy, 1.0L);
+  return ProjectReference(Rs * (Rt.transpose() * ray), s);
+}
+
+bool IsSurface(float d) { return d > 0 && std::isfinite(d); }
+
+// Whether the reference occlusion test passes for a target surface point at source depth
+// r.z landing at (r.u, r.v) inside the source; *ambiguous when it is within rounding of
+// the tolerance.
+bool ReferenceSeesDepth(const Image& source_depth, const Reference& r, bool* ambiguous) {
+  const int w_s = source_depth.width, h_s = source_depth.height;
+  auto depth_at = [&](int sx, int sy) -> long double { return source_depth.at(sx, sy); };
+  // Nearest pixel, else bilinear between the 4 nearest centres when all are surface.
+  const long double dn =
+      EffectiveDepth(source_depth.at(static_cast<int>(r.u), static_cast<int>(r.v)), 1e9);
+  const long double margin_n = std::fabs(r.z - dn) - 0.01L * r.z;
+  const long double fx = std::clamp(r.u - 0.5L, 0.0L, w_s - 1.0L);
+  const long double fy = std::clamp(r.v - 0.5L, 0.0L, h_s - 1.0L);
+  const int x0 = std::min(static_cast<int>(fx), w_s - 2);
+  const int y0 = std::min(static_cast<int>(fy), h_s - 2);
+  const long double ax = fx - x0, ay = fy - y0;
+  const bool all_surface = IsSurface(source_depth.at(x0, y0)) &&
+                           IsSurface(source_depth.at(x0 + 1, y0)) &&
+                           IsSurface(source_depth.at(x0, y0 + 1)) &&
+                           IsSurface(source_depth.at(x0 + 1, y0 + 1));
+  const long double db =
+      (1 - ay) * ((1 - ax) * depth_at(x0, y0) + ax * depth_at(x0 + 1, y0)) +
+      ay * ((1 - ax) * depth_at(x0, y0 + 1) + ax * depth_at(x0 + 1, y0 + 1));
+  const long double margin_b = std::fabs(r.z - db) - 0.01L * r.z;
+  *ambiguous = std::fabs(margin_n) < 1e-6L * r.z ||
+               (all_surface && std::fabs(margin_b) < 1e-6L * r.z);
+  return margin_n <= 0 || (all_surface && margin_b <= 0);
 }
 
 void CheckAgainstBruteForce(const Eigen::Vector3d& origin, uint32_t seed) {
@@ -71,13 +114,17 @@ void CheckAgainstBruteForce(const Eigen::Vector3d& origin, uint32_t seed) {
         : r < 0.08 ? std::numeric_limits<float>::quiet_NaN()
                    : static_cast<float>(2 + 6 * u01(rng));
   }
-  // Source depth: random, then made consistent (within 0.5%) where half the targets land.
+  // Source depth: random with 10% without a surface (where the target's background is
+  // seen at infinity), then made consistent (within 0.5%) where half the target surface
+  // points land.
   Image source_depth(source.width, source.height, 1);
-  for (float& d : source_depth.data) d = static_cast<float>(1 + 10 * u01(rng));
+  for (float& d : source_depth.data) {
+    d = u01(rng) < 0.1 ? 0.f : static_cast<float>(1 + 10 * u01(rng));
+  }
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const double d = EffectiveDepth(target_depth.at(x, y), 1e9);
-      const Reference r = BruteForce(target, x, y, d, source);
+      if (!IsSurface(target_depth.at(x, y))) continue;
+      const Reference r = BruteForce(target, x, y, target_depth.at(x, y), source);
       if (r.in_front && r.u >= 0 && r.v >= 0 && r.u < source.width &&
           r.v < source.height && u01(rng) < 0.5) {
         source_depth.at(static_cast<int>(r.u), static_cast<int>(r.v)) =
@@ -86,17 +133,18 @@ void CheckAgainstBruteForce(const Eigen::Vector3d& origin, uint32_t seed) {
     }
   }
   const WarpMap map = ComputeWarpMap(target, target_depth, source, source_depth);
-  int checked_valid = 0, checked = 0;
+  int checked_valid = 0, checked = 0, valid_at_infinity = 0;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const size_t i = static_cast<size_t>(y) * w + x;
       const float raw = target_depth.at(x, y);
-      const bool surface = raw > 0 && std::isfinite(raw);
+      const bool surface = IsSurface(raw);
       EXPECT_EQ(map.valid_depth.data[i], surface ? 1.f : 0.f);
-      const double d = EffectiveDepth(raw, 1e9);
-      const Reference r = BruteForce(target, x, y, d, source);
+      const Reference r = surface ? BruteForce(target, x, y, raw, source)
+                                  : BruteForceAtInfinity(target, x, y, source);
       ASSERT_TRUE(std::isfinite(map.source_xy.data[2 * i]));
       ASSERT_TRUE(std::isfinite(map.source_xy.data[2 * i + 1]));
+      if (!surface) EXPECT_EQ(map.source_z.data[i], 0.f);
       if (!r.in_front) {
         EXPECT_EQ(map.valid_warp.data[i], 0.f);
         continue;
@@ -112,29 +160,15 @@ void CheckAgainstBruteForce(const Eigen::Vector3d& origin, uint32_t seed) {
       const bool inside =
           r.u >= 0 && r.v >= 0 && r.u < source.width && r.v < source.height;
       bool expected = false;
-      if (inside) {
-        // Nearest pixel, else bilinear between the 4 nearest centres when all are
-        // surface.
-        const int w_s = source.width, h_s = source.height;
-        auto depth_at = [&](int sx, int sy) -> long double {
-          return source_depth.at(sx, sy);
-        };
-        const long double dn = EffectiveDepth(
-            source_depth.at(static_cast<int>(r.u), static_cast<int>(r.v)), 1e9);
-        const long double margin_n = std::fabs(r.z - dn) - 0.01L * r.z;
-        const long double fx = std::clamp(r.u - 0.5L, 0.0L, w_s - 1.0L);
-        const long double fy = std::clamp(r.v - 0.5L, 0.0L, h_s - 1.0L);
-        const int x0 = std::min(static_cast<int>(fx), w_s - 2);
-        const int y0 = std::min(static_cast<int>(fy), h_s - 2);
-        const long double ax = fx - x0, ay = fy - y0;
-        const long double db =
-            (1 - ay) * ((1 - ax) * depth_at(x0, y0) + ax * depth_at(x0 + 1, y0)) +
-            ay * ((1 - ax) * depth_at(x0, y0 + 1) + ax * depth_at(x0 + 1, y0 + 1));
-        const long double margin_b = std::fabs(r.z - db) - 0.01L * r.z;
-        if (std::fabs(margin_n) < 1e-6L * r.z || std::fabs(margin_b) < 1e-6L * r.z)
-          continue;
+      if (inside && surface) {
+        bool ambiguous = false;
+        expected = ReferenceSeesDepth(source_depth, r, &ambiguous);
+        if (ambiguous) continue;
+      } else if (inside) {
+        // At infinity: seen where the source has no surface either.
         expected =
-            margin_n <= 0 || margin_b <= 0;  // the source depth is all surface here
+            !IsSurface(source_depth.at(static_cast<int>(r.u), static_cast<int>(r.v)));
+        valid_at_infinity += expected;
       }
       // Pixels whose projection is a hair from a pixel border are ambiguous.
       const long double fu = r.u - std::floor(r.u), fv = r.v - std::floor(r.v);
@@ -145,6 +179,7 @@ void CheckAgainstBruteForce(const Eigen::Vector3d& origin, uint32_t seed) {
       checked_valid += expected;
     }
   }
+  EXPECT_GT(valid_at_infinity, 0);
   // The test must exercise both outcomes.
   EXPECT_GT(checked_valid, w * h / 10);
   EXPECT_GT(checked - checked_valid, w * h / 20);
@@ -193,6 +228,98 @@ TEST(WarpTest, DepthZeroAndHugeEverywhereStayFinite) {
   Image zero(16, 12, 1, 0.f);
   const WarpMap sky = ComputeWarpMap(target, zero, source, zero);
   EXPECT_GT(sky.num_valid, 0);
+}
+
+// A source 30 degrees to the side, far from the target: far beyond the old 1e9 stand-in
+// test's ~8 degrees. The background lands where the rotation alone puts it, whatever the
+// translation.
+TEST(WarpTest, BackgroundIsWarpedAtInfinityWithTheRotationOnly) {
+  const PinholeCamera target = SimpleCamera(40, 30, 36);
+  PinholeCamera rotated = target;
+  rotated.R = Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  PinholeCamera moved = rotated;
+  moved.t = Eigen::Vector3d(7, -3, 12);
+  const Image sky(40, 30, 1, 0.f);
+  const WarpMap a = ComputeWarpMap(target, sky, rotated, sky);
+  const WarpMap b = ComputeWarpMap(target, sky, moved, sky);
+  ExpectFinite(b);
+  EXPECT_EQ(a.source_xy.data, b.source_xy.data);
+  EXPECT_EQ(a.valid_warp.data, b.valid_warp.data);
+  for (float v : b.valid_depth.data) EXPECT_EQ(v, 0.f);
+  for (float v : b.source_z.data) EXPECT_EQ(v, 0.f);
+  // Target pixel (x, y): its ray rotated into the source, projected.
+  int valid = 0, outside = 0;
+  for (int y = 0; y < 30; ++y) {
+    for (int x = 0; x < 40; ++x) {
+      const Eigen::Vector3d d =
+          rotated.R * Eigen::Vector3d((x + 0.5 - 20) / 36, (y + 0.5 - 15) / 36, 1);
+      const double u = 36 * d.x() / d.z() + 20, v = 36 * d.y() / d.z() + 15;
+      const size_t i = static_cast<size_t>(y) * 40 + x;
+      EXPECT_NEAR(b.source_xy.data[2 * i], u, 1e-4);
+      EXPECT_NEAR(b.source_xy.data[2 * i + 1], v, 1e-4);
+      const bool inside = u >= 0 && v >= 0 && u < 40 && v < 30;
+      EXPECT_EQ(b.valid_warp.data[i], inside ? 1.f : 0.f) << x << "," << y;
+      valid += inside;
+      outside += !inside;
+    }
+  }
+  EXPECT_EQ(b.num_valid, valid);
+  EXPECT_GT(valid, 200);    // the half of the target the source looks at
+  EXPECT_GT(outside, 200);  // and the rest, outside the source image
+}
+
+TEST(WarpTest, SourceSurfaceOccludesTheBackground) {
+  const PinholeCamera target = SimpleCamera(40, 30, 36);
+  PinholeCamera source = target;
+  source.R = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  source.t = Eigen::Vector3d(0.5, 0, 0);
+  // The source has a surface in its left half: the background behind it is hidden there.
+  Image source_depth(40, 30, 1, 0.f);
+  for (int y = 0; y < 30; ++y) {
+    for (int x = 0; x < 20; ++x) source_depth.at(x, y) = 3.f;
+  }
+  const WarpMap map = ComputeWarpMap(target, Image(40, 30, 1, 0.f), source, source_depth);
+  int hidden = 0, seen = 0;
+  for (size_t i = 0; i < map.valid_warp.data.size(); ++i) {
+    const double u = map.source_xy.data[2 * i], v = map.source_xy.data[2 * i + 1];
+    if (!(u >= 0 && v >= 0 && u < 40 && v < 30)) {
+      EXPECT_EQ(map.valid_warp.data[i], 0.f);
+      continue;
+    }
+    const bool behind_surface = static_cast<int>(u) < 20;
+    EXPECT_EQ(map.valid_warp.data[i], behind_surface ? 0.f : 1.f);
+    hidden += behind_surface;
+    seen += !behind_surface;
+  }
+  EXPECT_GT(hidden, 100);
+  EXPECT_GT(seen, 100);
+  // Target surface pixels keep the depth test: a point at the source's far side has no
+  // source surface to match, so it is not seen (and never "seen at infinity").
+  Image near(40, 30, 1, 3.f);
+  const WarpMap surface = ComputeWarpMap(target, near, source, source_depth);
+  for (size_t i = 0; i < surface.valid_warp.data.size(); ++i) {
+    const double u = surface.source_xy.data[2 * i];
+    if (u >= 20 && u < 40) EXPECT_EQ(surface.valid_warp.data[i], 0.f);
+  }
+}
+
+TEST(WarpTest, BackgroundAtExtremePosesStaysFinite) {
+  const Image sky(12, 10, 1, 0.f);
+  for (double f : {1e-3, 14.0, 1e7}) {
+    const PinholeCamera target = SimpleCamera(12, 10, f);
+    for (double angle : {0.0, M_PI / 2, M_PI / 2 - 1e-12, M_PI, 3.0}) {
+      for (double distance : {0.0, 1e-9, 1e12}) {
+        PinholeCamera source = target;
+        source.R = Eigen::AngleAxisd(angle, Eigen::Vector3d(1, 2, 0.5).normalized())
+                       .toRotationMatrix();
+        source.t = Eigen::Vector3d(distance, -distance, 0.5 * distance);
+        const WarpMap map = ComputeWarpMap(target, sky, source, sky);
+        ExpectFinite(map);
+        // Looking the other way (a wide-angle target still reaches round the side).
+        if (angle == M_PI && f == 14.0) EXPECT_EQ(map.num_valid, 0);
+      }
+    }
+  }
 }
 
 TEST(WarpTest, TargetBehindSourceAndEdgeOnAreInvalidButFinite) {

@@ -245,7 +245,7 @@ TEST_F(PackTest, ColourJitterIsTheSameForTargetAndSources) {
 TEST_F(PackTest, TrainingWarpAgreesWithCpuWarpMaps) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> jitter(-0.3, 0.3);
-  int64_t compared = 0, valid = 0, mask_mismatch = 0;
+  int64_t compared = 0, valid = 0, valid_at_infinity = 0, mask_mismatch = 0;
   double max_grid_error = 0, max_prior_error = 0;
   for (int trial = 0; trial < 6; ++trial) {
     // Scene cameras are scene-centred.
@@ -253,12 +253,17 @@ TEST_F(PackTest, TrainingWarpAgreesWithCpuWarpMaps) {
     target.fx *= 1 + 0.2 * jitter(rng);
     target.cy += 3 * jitter(rng);
     target.t += Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng)) * 0.5;
-    const Image target_depth = scene_->RenderDepth(target);
+    // The top rows without a surface in the target and in the sources: a background
+    // beyond the mesh, warped at infinity.
+    Image target_depth = scene_->RenderDepth(target);
+    std::fill(target_depth.data.begin(), target_depth.data.begin() + 8 * 40, 0.f);
     std::vector<PinholeCamera> sources;
     std::vector<Image> source_depths;
     for (int k : {0, 2, 5}) {
       sources.push_back(scene_->view(k).camera.Resized(48, 36));
       source_depths.push_back(scene_->RenderDepth(sources.back()));
+      std::fill(source_depths.back().data.begin(),
+                source_depths.back().data.begin() + 10 * 48, 0.f);
     }
     std::vector<torch::Tensor> ks, rs, ts, ds;
     for (size_t k = 0; k < sources.size(); ++k) {
@@ -290,8 +295,11 @@ TEST_F(PackTest, TrainingWarpAgreesWithCpuWarpMaps) {
       bool sees[3];
       double weights[3];
       for (int k = 0; k < 3; ++k) sees[k] = maps[k].valid_warp.data[i] > 0;
-      const Eigen::Vector3d point = target.PixelToCamera(
-          i % 40 + 0.5, i / 40 + 0.5, EffectiveDepth(target_depth.data[i], 1e9));
+      const float d = target_depth.data[i];
+      const Eigen::Vector3d point =
+          d > 0 ? target.PixelToCamera(i % 40 + 0.5, i / 40 + 0.5, d)
+                : UlrPointAtInfinity(target.PixelToCamera(i % 40 + 0.5, i / 40 + 0.5, 1),
+                                     UlrFarDistance(ulr));
       UlrPointWeights(point, ulr, sees, UlrSettings(), weights);
       for (int k = 0; k < 3; ++k) {
         const double expected = std::log(std::max(weights[k], kUlrWeightFloor));
@@ -312,6 +320,7 @@ TEST_F(PackTest, TrainingWarpAgreesWithCpuWarpMaps) {
           EXPECT_EQ(vd.data_ptr<float>()[i], map.valid_depth.data[i]);
           mask_mismatch += vw.data_ptr<float>()[i] != map.valid_warp.data[i];
           valid += map.valid_warp.data[i] > 0;
+          valid_at_infinity += map.valid_warp.data[i] > 0 && map.valid_depth.data[i] == 0;
           if (std::abs(grid.data[2 * i]) < 4 && std::abs(grid.data[2 * i + 1]) < 4) {
             max_grid_error = std::max<double>(
                 max_grid_error,
@@ -325,6 +334,7 @@ TEST_F(PackTest, TrainingWarpAgreesWithCpuWarpMaps) {
     }
   }
   EXPECT_GT(valid, compared / 4);  // the test sees real warps, not an empty mask
+  EXPECT_GT(valid_at_infinity, compared / 20);  // and the background at infinity
   EXPECT_EQ(mask_mismatch, 0);
   EXPECT_LT(max_grid_error, 1e-5);
   EXPECT_LT(max_prior_error, 1e-4);
@@ -343,8 +353,8 @@ TEST_F(PackTest, NoInfDepthLeavesSkyInvalid) {
   EXPECT_EQ(s.warp.valid_warp.sum().item<float>(), 0.f);
   EXPECT_TRUE(torch::isfinite(s.warp.grid).all().item<bool>());
   settings.inf_depth = true;
-  // Far-away points: their source positions are finite (valid only where the source has
-  // sky too, which this closed room has nowhere).
+  // Points at infinity: their source positions are finite (valid only where the source
+  // has sky too, which this closed room has nowhere).
   const TrainingSample t = MakeSample(p, 0, {1, 2}, 0, 0, 48, 36, settings);
   EXPECT_TRUE(torch::isfinite(t.warp.grid).all().item<bool>());
   EXPECT_EQ(t.warp.valid_warp.sum().item<float>(), 0.f);

@@ -40,6 +40,22 @@ Image Thumbnail(const Image& image, int width) {
   return ResizeImage(image, width, height);
 }
 
+// ViewResult's mesh_pixels, infinity_pixels and filled_pixels of a render (n/a when the
+// method gave no coverage).
+void CountPixelOrigins(const RenderResult& result, ViewResult* r) {
+  const size_t n = result.coverage.data.size();
+  if (n == 0) return;
+  const bool have_infinity = result.infinity.data.size() == n;
+  double covered = 0, at_infinity = 0;
+  for (size_t i = 0; i < n; ++i) {
+    covered += result.coverage.data[i] > 0;
+    at_infinity += have_infinity && result.infinity.data[i] > 0;
+  }
+  r->mesh_pixels = (covered - at_infinity) / n;
+  r->infinity_pixels = at_infinity / n;
+  r->filled_pixels = 1.0 - covered / n;
+}
+
 }  // namespace
 
 std::string EvalConfig::Label() const {
@@ -152,6 +168,7 @@ std::vector<ViewResult> EvaluateTargets(
         double covered = 0;
         for (float c : result.coverage.data) covered += c;
         r.coverage = covered / std::max<size_t>(1, result.coverage.data.size());
+        CountPixelOrigins(result, &r);
         Require(std::isfinite(r.psnr) && std::isfinite(r.ssim), target.name,
                 "metrics are not finite (NaN or Inf in the rendered image)");
         if (!options.write_images_dir.empty()) {
@@ -168,6 +185,7 @@ std::vector<ViewResult> EvaluateTargets(
         r.error = e.what();
         r.psnr = r.ssim = r.lpips = r.seconds = r.cpu_seconds = r.coverage =
             kNotAvailable;
+        r.mesh_pixels = r.infinity_pixels = r.filled_pixels = kNotAvailable;
         r.psnr_covered = r.ssim_covered = kNotAvailable;
       }
     }

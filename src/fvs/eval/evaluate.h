@@ -64,7 +64,14 @@ struct ViewResult {
   double cpu_seconds = kNotAvailable;
   int sources_used = 0;
   double coverage = kNotAvailable;  // fraction of pixels some source contributed to
-  int width = 0, height = 0;        // the photo's size (metrics are computed at it)
+  // Where the pixels came from, as fractions of the rendered pixels (they sum to 1):
+  // blended from the sources' view of the mesh's surface, from the background the
+  // sources see at infinity beyond the mesh (RenderResult::infinity), and from neither
+  // (no source sees them: filled by push-pull, or black with --fill_holes 0).
+  double mesh_pixels = kNotAvailable;
+  double infinity_pixels = kNotAvailable;
+  double filled_pixels = kNotAvailable;
+  int width = 0, height = 0;  // the photo's size (metrics are computed at it)
 
   bool ok() const { return error.empty(); }
 };

@@ -12,11 +12,23 @@ namespace fvs::eval {
 namespace {
 
 const std::vector<std::string> kColumns = {
-    "scene",       "method",       "num_sources",      "scale",        "precision",
-    "protocol",    "target",       "geometry_holdout", "status",       "psnr",
-    "ssim",        "lpips",        "psnr_covered",     "ssim_covered", "seconds",
-    "cpu_seconds", "sources_used", "coverage",         "width",        "height",
-    "error"};
+    "scene",         "method",       "num_sources", "scale",
+    "precision",     "protocol",     "target",      "geometry_holdout",
+    "status",        "psnr",         "ssim",        "lpips",
+    "psnr_covered",  "ssim_covered", "seconds",     "cpu_seconds",
+    "sources_used",  "coverage",     "mesh_pixels", "infinity_pixels",
+    "filled_pixels", "width",        "height",      "error"};
+// Where the pixel-origin columns start; files written before them lack the three.
+constexpr size_t kFirstOriginColumn = 18;
+constexpr size_t kNumOriginColumns = 3;
+
+// The header of results.csv files written before the pixel-origin columns.
+std::vector<std::string> LegacyColumns() {
+  std::vector<std::string> legacy = kColumns;
+  legacy.erase(legacy.begin() + kFirstOriginColumn,
+               legacy.begin() + kFirstOriginColumn + kNumOriginColumns);
+  return legacy;
+}
 
 std::string CsvField(const std::string& s) {
   if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
@@ -176,8 +188,9 @@ void WriteResultsCsv(const std::string& path, const std::vector<ViewResult>& res
           << FormatNumber(r.lpips, 5) << "," << FormatNumber(r.psnr_covered, 4) << ","
           << FormatNumber(r.ssim_covered, 5) << "," << FormatNumber(r.seconds, 4) << ","
           << FormatNumber(r.cpu_seconds, 4) << "," << r.sources_used << ","
-          << FormatNumber(r.coverage, 4) << "," << r.width << "," << r.height << ","
-          << CsvField(r.error) << "\n";
+          << FormatNumber(r.coverage, 4) << "," << FormatNumber(r.mesh_pixels, 4) << ","
+          << FormatNumber(r.infinity_pixels, 4) << "," << FormatNumber(r.filled_pixels, 4)
+          << "," << r.width << "," << r.height << "," << CsvField(r.error) << "\n";
     }
   });
 }
@@ -188,13 +201,17 @@ std::vector<ViewResult> ReadResultsCsv(const std::string& path) {
   std::vector<std::string> fields;
   Require(static_cast<bool>(std::getline(in, line)), path, "empty file");
   SplitCsvLine(line, &fields);
-  Require(fields == kColumns, path,
+  const bool legacy = fields == LegacyColumns();
+  Require(fields == kColumns || legacy, path,
           "line 1: not a view_synthesis_eval results.csv header");
   std::vector<ViewResult> results;
   for (int number = 2; std::getline(in, line); ++number) {
     if (line.empty() || line == "\r") continue;
     const std::string where = path + ":" + std::to_string(number);
     Require(SplitCsvLine(line, &fields), where, "unterminated quote");
+    if (legacy && fields.size() == kColumns.size() - kNumOriginColumns) {
+      fields.insert(fields.begin() + kFirstOriginColumn, kNumOriginColumns, "n/a");
+    }
     Require(fields.size() == kColumns.size(), where,
             std::to_string(fields.size()) + " fields, expected " +
                 std::to_string(kColumns.size()));
@@ -218,9 +235,12 @@ std::vector<ViewResult> ReadResultsCsv(const std::string& path) {
     r.cpu_seconds = ParseNumber(fields[15], where);
     r.sources_used = ParseInt(fields[16], where);
     r.coverage = ParseNumber(fields[17], where);
-    r.width = ParseInt(fields[18], where);
-    r.height = ParseInt(fields[19], where);
-    r.error = fields[20];
+    r.mesh_pixels = ParseNumber(fields[18], where);
+    r.infinity_pixels = ParseNumber(fields[19], where);
+    r.filled_pixels = ParseNumber(fields[20], where);
+    r.width = ParseInt(fields[21], where);
+    r.height = ParseInt(fields[22], where);
+    r.error = fields[23];
     if (ok) {
       Require(r.error.empty(), where, "status ok with an error message");
       Require(std::isfinite(r.psnr) && std::isfinite(r.ssim) && std::isfinite(r.seconds),

@@ -2,7 +2,7 @@
 //   targets: --target_images images.txt | --camera_path camera_path.json | --orbit N |
 //            --interpolate N
 //   --method ulr|nearest|fvs, --num_sources K, --width/--height/--scale,
-//   --write_depth, --write_confidence, --write_sources
+//   --write_depth, --write_confidence, --write_infinity, --write_sources
 //   videos: --video out.mp4 (ffmpeg when installed), --fps, --stable_sources 1
 //   (--source_hysteresis, --stable_source_order), --temporal_blend a, --flag_coverage c,
 //   --ground_truth_path G (PSNR of every frame that has an image of its name in G)
@@ -204,6 +204,9 @@ int RunViewSynthesis(int argc, char** argv) {
                      "also write <name>.depth.bin and <name>.depth.png");
   options.AddDefault("write_confidence", &o.output.write_confidence,
                      "also write <name>.confidence.png");
+  options.AddDefault("write_infinity", &o.output.write_infinity,
+                     "also write <name>.infinity.png (white: rendered from the "
+                     "background at infinity)");
   options.AddDefault("write_sources", &o.output.write_sources,
                      "also write <name>.sources.json");
   options.AddDefault("fill_holes", &o.render.fill_holes,

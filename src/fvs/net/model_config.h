@@ -26,8 +26,8 @@ struct ModelConfig {
   // Per-source RGB + confidence, softmax over sources. false: one RGB head on the final
   // state.
   bool soft_argmax = true;
-  // Invalid target depth becomes 1e9 ("far away") in the renderer; false: stays
-  // 0/invalid.
+  // Pixels without target depth are warped at infinity (scene/warp.h); false: they have
+  // no valid warp.
   bool inf_depth = true;
   // Encoder: VGG16 stage widths and conv counts (stages 1-3); decoder mirrors the widths.
   // Empty: no encoder (the photos' colours are warped as they are).

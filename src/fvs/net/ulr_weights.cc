@@ -30,6 +30,20 @@ double UlrPenalty(const Eigen::Vector3d& point, const Eigen::Vector3d& target_ce
   return std::isfinite(p) ? std::max(p, 0.0) : M_PI;
 }
 
+double UlrFarDistance(const UlrSources& sources) {
+  double farthest = 0;
+  for (const Eigen::Vector3d& c : sources.centers)
+    farthest = std::max(farthest, c.norm());
+  const double d = kUlrFarFactor * farthest;
+  return d > 0 && std::isfinite(d) ? d : 1.0;
+}
+
+Eigen::Vector3d UlrPointAtInfinity(const Eigen::Vector3d& ray, double far_distance) {
+  const double n = ray.norm();
+  if (!(n > 0 && std::isfinite(n))) return Eigen::Vector3d(0, 0, far_distance);
+  return ray * (far_distance / n);
+}
+
 void UlrWeights(const double* penalties, int n, int k, double* weights) {
   if (n <= 0) return;
   k = std::max(1, k);

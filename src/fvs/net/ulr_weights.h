@@ -11,6 +11,16 @@
 //   p_i, normalised.
 // The 1 / p_i factor (as in later ULR implementations) makes a target that coincides with
 // a source reproduce that source exactly.
+//
+// Pixels without a surface (seen at infinity, scene/warp.h) have no point to measure the
+// angle at: at infinity every source's ray is parallel to the target's and all angles
+// are 0. They are weighed at the point D_far along their ray instead
+// (UlrPointAtInfinity), D_far = kUlrFarFactor (10) times the distance from the target
+// centre to the farthest of its sources' centres (1 when they all coincide with it).
+// There the angle is about the source centre's distance from the target ray over D_far
+// (at most 0.1 rad), so the sources nearest to the line of sight weigh most, as ULR does
+// for a distant surface, and the weights depend on the sources' layout only, not on the
+// scene's scale.
 #pragma once
 
 #include <Eigen/Core>
@@ -43,6 +53,16 @@ struct UlrSources {
   std::vector<double> focals;
   int size() const { return static_cast<int>(centers.size()); }
 };
+
+// D_far above, as a multiple of the farthest source centre's distance.
+constexpr double kUlrFarFactor = 10.0;
+
+// D_far of these sources (> 0 and finite).
+double UlrFarDistance(const UlrSources& sources);
+
+// The point a pixel without a surface is weighed at: D_far along its ray direction
+// (target camera frame, any length > 0).
+Eigen::Vector3d UlrPointAtInfinity(const Eigen::Vector3d& ray, double far_distance);
 
 // Weights of every source at one surface point (target camera frame): 0 where
 // sees[s] is false, the others sum to 1. Returns how many sources see the point (0: all

@@ -32,10 +32,12 @@ torch::Tensor UlrLogWeightTensor(const Scene& scene, const TargetView& target,
   const PinholeCamera& cam = target.camera;
   const int w = cam.width, h = cam.height;
   const int64_t num_pixels = static_cast<int64_t>(w) * h;
+  const UlrSources sources = MakeUlrSources(scene, target, prepared);
+  const double far_distance = UlrFarDistance(sources);
   std::vector<double> points(3 * num_pixels);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const Eigen::Vector3d p = UlrSurfacePoint(cam, depth, x, y);
+      const Eigen::Vector3d p = UlrSurfacePoint(cam, depth, x, y, far_distance);
       const int64_t i = static_cast<int64_t>(y) * w + x;
       for (int c = 0; c < 3; ++c) points[3 * i + c] = p[c];
     }
@@ -46,9 +48,8 @@ torch::Tensor UlrLogWeightTensor(const Scene& scene, const TargetView& target,
   UlrSettings settings;
   settings.num_blend = config.ulr_num_blend;
   settings.resolution_weight = config.ulr_resolution_weight;
-  UlrLogWeights(points.data(), num_pixels, MakeUlrSources(scene, target, prepared),
-                sees.data_ptr<float>(), settings, log_weights.data_ptr<float>(),
-                num_threads);
+  UlrLogWeights(points.data(), num_pixels, sources, sees.data_ptr<float>(), settings,
+                log_weights.data_ptr<float>(), num_threads);
   return log_weights.reshape({k, 1, h, w});
 }
 
@@ -133,6 +134,7 @@ class FvsMethod : public Method {
     result.color = Image(w, h, 3, 0.0f);
     result.confidence = Image(w, h, 1, 0.0f);
     result.coverage = Image(w, h, 1, 0.0f);
+    result.infinity = Image(w, h, 1, 0.0f);
     const int k = static_cast<int>(prepared.sources.size());
     if (k == 0) return result;  // no source sees anything: black, coverage 0
 
@@ -203,6 +205,7 @@ class FvsMethod : public Method {
     // (TensorToImage brings any device and dtype to a float image on the CPU.)
     result.color = TensorToImage((rgb + 1.0) * 0.5);
     result.coverage = TensorToImage(warp_mask.sum(0, true) > 0);
+    result.infinity = AtInfinityMask(result.depth, result.coverage);
     result.confidence = have_weights ? TensorToImage(seen_weight) : result.coverage;
     result.timings.blend_s = timer.Seconds() - result.timings.encode_s;
     return result;

@@ -41,6 +41,20 @@ void RenderOptions::Check() const {
           "'" + precision + "': must be fp32, bf16 or fp16");
 }
 
+Image AtInfinityMask(const Image& depth, const Image& coverage) {
+  if (depth.width != coverage.width || depth.height != coverage.height ||
+      depth.channels != 1 || coverage.channels != 1) {
+    return Image();
+  }
+  Image mask(depth.width, depth.height, 1);
+  for (size_t i = 0; i < mask.data.size(); ++i) {
+    const float d = depth.data[i];
+    const bool surface = d > 0 && std::isfinite(d);
+    mask.data[i] = !surface && coverage.data[i] > 0 ? 1.f : 0.f;
+  }
+  return mask;
+}
+
 namespace {
 
 // Any method, its holes filled afterwards (the same for every method, so comparisons

@@ -50,8 +50,9 @@ struct RenderOptions {
   // Feed the selected sources in view order rather than best first, so that the
   // recurrent blend sees a fixed order while the set does not change.
   bool stable_source_order = false;
-  // Pixels no source sees get colours pushed and pulled from the covered pixels around
-  // them (render/hole_filling.h) instead of black; coverage and confidence stay 0 there.
+  // Pixels no source sees, not even at infinity, get colours pushed and pulled from the
+  // covered pixels around them (util/hole_filling.h) instead of black; coverage and
+  // confidence stay 0 there.
   bool fill_holes = true;
   // Network methods: where and in what precision the network runs. device: auto (CUDA
   // when this build and machine have it, else the CPU), cpu or cuda. precision: fp32,
@@ -98,9 +99,17 @@ struct RenderResult {
   Image depth;       // 1 channel, target depth from the mesh (0 = no surface)
   Image confidence;  // 1 channel in [0, 1]; 0 where not covered
   Image coverage;    // 1 channel, 1 where at least one source contributed
+  // 1 channel, 1 where the pixel has no surface (depth 0) but some source sees it at
+  // infinity (scene/warp.h), so it was rendered from the background beyond the mesh;
+  // AtInfinityMask of depth and coverage.
+  Image infinity;
   std::vector<SourceScore> sources;  // used, best first
   RenderTimings timings;
 };
+
+// 1 where depth has no surface (<= 0 or non-finite) and coverage > 0, else 0; empty when
+// the sizes differ.
+Image AtInfinityMask(const Image& depth, const Image& coverage);
 
 class Method {
  public:

@@ -1,4 +1,6 @@
-// `nearest`: the best-ranked source alone, reprojected through the target depth.
+// `nearest`: the best-ranked source alone, reprojected through the target depth; pixels
+// without a surface take its colour where it sees them at infinity (scene/warp.h), as
+// the others where it sees their surface.
 #include <algorithm>
 #include <cmath>
 
@@ -54,6 +56,7 @@ class NearestMethod : public Method {
           options_.num_threads);
     }
     result.depth = std::move(prepared.depth);
+    result.infinity = AtInfinityMask(result.depth, result.coverage);
     result.timings.blend_s = timer.Seconds();
     return result;
   }

@@ -71,6 +71,17 @@ void WriteRenderOutputs(const std::string& output_dir, const std::string& name,
     }
     colmap::WriteImage(stem + ".confidence.png", grey, 16);
   }
+  if (options.write_infinity) {
+    // A method that sets no mask: nothing was rendered from infinity.
+    const Image mask = result.infinity.empty()
+                           ? Image(result.color.width, result.color.height, 1)
+                           : result.infinity;
+    Image grey(mask.width, mask.height, 3);
+    for (size_t i = 0; i < mask.data.size(); ++i) {
+      for (int c = 0; c < 3; ++c) grey.data[3 * i + c] = mask.data[i] > 0 ? 1.f : 0.f;
+    }
+    colmap::WriteImage(stem + ".infinity.png", grey);
+  }
   if (options.write_sources) {
     nlohmann::json json;
     json["target"] = name;

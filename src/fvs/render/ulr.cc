@@ -36,6 +36,7 @@ class UlrMethod : public Method {
       photos.push_back(&scene.SourceImage(s.view_index));
     }
     const UlrSources ulr_sources = MakeUlrSources(scene, target, prepared);
+    const double far_distance = UlrFarDistance(ulr_sources);
     UlrSettings settings;
     settings.resolution_weight = options_.ulr_resolution_weight;
     settings.num_blend = options_.ulr_num_blend;
@@ -50,7 +51,8 @@ class UlrMethod : public Method {
           float sample[4];
           for (int x = 0; x < w; ++x) {
             const size_t i = static_cast<size_t>(y) * w + x;
-            const Eigen::Vector3d point = UlrSurfacePoint(cam, prepared.depth, x, y);
+            const Eigen::Vector3d point =
+                UlrSurfacePoint(cam, prepared.depth, x, y, far_distance);
             for (int s = 0; s < n; ++s)
               sees[s] = prepared.warps[s].valid_warp.data[i] > 0;
             const int m =
@@ -75,6 +77,7 @@ class UlrMethod : public Method {
         },
         options_.num_threads);
     result.depth = std::move(prepared.depth);
+    result.infinity = AtInfinityMask(result.depth, result.coverage);
     result.timings.blend_s = timer.Seconds();
     return result;
   }
@@ -86,10 +89,10 @@ class UlrMethod : public Method {
 }  // namespace
 
 Eigen::Vector3d UlrSurfacePoint(const PinholeCamera& target, const Image& depth, int x,
-                                int y) {
-  const double d = EffectiveDepth(depth.data[static_cast<size_t>(y) * depth.width + x],
-                                  WarpOptions().invalid_depth);
-  return target.PixelToCamera(x + 0.5, y + 0.5, d);
+                                int y, double far_distance) {
+  const float d = depth.data[static_cast<size_t>(y) * depth.width + x];
+  if (d > 0 && std::isfinite(d)) return target.PixelToCamera(x + 0.5, y + 0.5, d);
+  return UlrPointAtInfinity(target.PixelToCamera(x + 0.5, y + 0.5, 1.0), far_distance);
 }
 
 UlrSources MakeUlrSources(const Scene& scene, const TargetView& target,

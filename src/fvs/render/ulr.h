@@ -1,8 +1,9 @@
 // Unstructured Lumigraph Rendering (Buehler et al., SIGGRAPH 2001) as a classical
 // baseline without a network: the K selected sources' colours, warped with the same
 // target depth and masks as the network sees, blended per pixel with ULR weights
-// (net/ulr_weights.h, shared with the network's prior). Pixels no source sees stay black
-// (coverage 0).
+// (net/ulr_weights.h, shared with the network's prior). Pixels without a surface are
+// blended from the sources that see them at infinity (scene/warp.h); pixels no source
+// sees stay black (coverage 0).
 #pragma once
 
 #include <memory>
@@ -17,10 +18,11 @@ class Scene;
 struct TargetView;
 
 // The surface point of target pixel (x, y) that ULR weighs the sources at, in the
-// target's camera frame: along the pixel centre's ray at the target depth, or at the
-// warp's invalid_depth ("far away") where the pixel has no surface.
+// target's camera frame: along the pixel centre's ray at the target depth, or, where the
+// pixel has no surface, UlrPointAtInfinity at far_distance (UlrFarDistance of the
+// target's sources; net/ulr_weights.h).
 Eigen::Vector3d UlrSurfacePoint(const PinholeCamera& target, const Image& depth, int x,
-                                int y);
+                                int y, double far_distance);
 
 // The selected sources of a prepared target as UlrSources (centres in the target frame).
 UlrSources MakeUlrSources(const Scene& scene, const TargetView& target,

@@ -45,9 +45,68 @@ bool SourceSeesDepth(const Image& source_depth, double u, double v, double z,
   return std::abs(z - bilinear) <= tolerance * z;
 }
 
-WarpMap ComputeWarpMap(const PinholeCamera& target, const Image& target_depth,
-                       const PinholeCamera& source, const Image& source_depth,
-                       const WarpOptions& options) {
+namespace {
+
+// Where a point (or, at infinity, a direction) in the source camera frame lands in the
+// source image.
+struct SourceHit {
+  // (-1, -1, 0) unless it projects (in front of the source, finite).
+  double u = -1, v = -1, z = 0;
+  bool inside = false;  // it projects inside the source image
+};
+
+SourceHit ProjectIntoSource(const PinholeCamera& source, const Eigen::Vector3d& X) {
+  SourceHit hit;
+  // Z relative to the scale of the point: a point behind or at the source centre has no
+  // projection.
+  if (!(X.z() > 1e-12 * std::max(1.0, X.norm()))) return hit;
+  const double u = source.fx * X.x() / X.z() + source.cx;
+  const double v = source.fy * X.y() / X.z() + source.cy;
+  if (!(std::isfinite(u) && std::isfinite(v))) return hit;
+  hit.u = u;
+  hit.v = v;
+  hit.z = X.z();
+  hit.inside = u >= 0 && v >= 0 && u < source.width && v < source.height;
+  return hit;
+}
+
+// One target pixel's ray (x, y, 1) in the target frame and its depth (0 = no surface).
+struct TargetRay {
+  Eigen::Vector3d ray;
+  double depth = 0;
+};
+
+// Writes pixel i of the map; returns whether the source sees it.
+bool WarpPixel(const TargetRay& pixel, const Eigen::Matrix3d& R_rel,
+               const Eigen::Vector3d& t_rel, const PinholeCamera& source,
+               const Image& source_depth, const WarpOptions& options, size_t i,
+               WarpMap* map) {
+  const bool surface = pixel.depth > 0;
+  // At infinity only the direction counts: the rotation alone, no translation, and no
+  // huge stand-in depth whose source Z would never match a stand-in source depth.
+  const Eigen::Vector3d X =
+      surface ? Eigen::Vector3d(R_rel * (pixel.depth * pixel.ray) + t_rel)
+              : Eigen::Vector3d(R_rel * pixel.ray);
+  const SourceHit hit = ProjectIntoSource(source, X);
+  bool seen = false;
+  if (hit.inside) {
+    seen = surface ? SourceSeesDepth(source_depth, hit.u, hit.v, hit.z,
+                                     options.occlusion_tolerance, options.invalid_depth)
+                   : SourceSeesInfinity(source_depth, hit.u, hit.v);
+  }
+  // Keep far-off coordinates finite in float and clearly outside.
+  const double lim = 1e7 + 4.0 * std::max(source.width, source.height);
+  map->source_xy.data[2 * i] = static_cast<float>(std::clamp(hit.u, -lim, lim));
+  map->source_xy.data[2 * i + 1] = static_cast<float>(std::clamp(hit.v, -lim, lim));
+  map->source_z.data[i] = surface ? static_cast<float>(std::min(hit.z, 1e30)) : 0.f;
+  map->valid_depth.data[i] = surface ? 1.f : 0.f;
+  map->valid_warp.data[i] = seen ? 1.f : 0.f;
+  return seen;
+}
+
+void CheckWarpInputs(const PinholeCamera& target, const Image& target_depth,
+                     const PinholeCamera& source, const Image& source_depth,
+                     const WarpOptions& options) {
   options.Check();
   Require(target.IsValid(), "warp", "invalid target camera");
   Require(source.IsValid(), "warp", "invalid source camera");
@@ -57,7 +116,21 @@ WarpMap ComputeWarpMap(const PinholeCamera& target, const Image& target_depth,
   Require(source_depth.width == source.width && source_depth.height == source.height &&
               source_depth.channels == 1,
           "warp", "source depth size does not match the source camera");
+}
 
+}  // namespace
+
+bool SourceSeesInfinity(const Image& source_depth, double u, double v) {
+  const int sx = std::min(static_cast<int>(u), source_depth.width - 1);
+  const int sy = std::min(static_cast<int>(v), source_depth.height - 1);
+  const float d = source_depth.at(sx, sy);
+  return !(d > 0 && std::isfinite(d));
+}
+
+WarpMap ComputeWarpMap(const PinholeCamera& target, const Image& target_depth,
+                       const PinholeCamera& source, const Image& source_depth,
+                       const WarpOptions& options) {
+  CheckWarpInputs(target, target_depth, source, source_depth, options);
   const int w = target.width, h = target.height;
   WarpMap map;
   map.source_xy = Image(w, h, 2);
@@ -68,46 +141,21 @@ WarpMap ComputeWarpMap(const PinholeCamera& target, const Image& target_depth,
   // Relative pose target camera -> source camera, once, in double.
   const Eigen::Matrix3d R_rel = source.R * target.R.transpose();
   const Eigen::Vector3d t_rel = source.t - R_rel * target.t;
-  const double tol = options.occlusion_tolerance;
-  const double invalid = options.invalid_depth;
   std::vector<int64_t> valid_per_row(h, 0);
-
   ParallelFor(
       0, h,
       [&](int64_t y) {
         int64_t valid_count = 0;
-        const double ny = (y + 0.5 - target.cy) / target.fy;
+        TargetRay pixel;
+        pixel.ray.y() = (y + 0.5 - target.cy) / target.fy;
+        pixel.ray.z() = 1.0;
         for (int x = 0; x < w; ++x) {
           const float raw = target_depth.at(x, static_cast<int>(y));
-          const bool surface = raw > 0 && std::isfinite(raw);
-          const double d = EffectiveDepth(raw, invalid);
-          const double nx = (x + 0.5 - target.cx) / target.fx;
-          const Eigen::Vector3d X = R_rel * Eigen::Vector3d(nx * d, ny * d, d) + t_rel;
+          pixel.depth = raw > 0 && std::isfinite(raw) ? raw : 0.0;
+          pixel.ray.x() = (x + 0.5 - target.cx) / target.fx;
           const size_t i = static_cast<size_t>(y) * w + x;
-          map.valid_depth.data[i] = surface ? 1.f : 0.f;
-          float u_out = -1.f, v_out = -1.f, z_out = 0.f, ok = 0.f;
-          // Z relative to the scale of the point: a point behind or at the source centre
-          // has no projection.
-          if (X.z() > 1e-12 * std::max(1.0, X.norm())) {
-            const double u = source.fx * X.x() / X.z() + source.cx;
-            const double v = source.fy * X.y() / X.z() + source.cy;
-            if (std::isfinite(u) && std::isfinite(v)) {
-              // Keep far-off coordinates finite in float and clearly outside.
-              const double lim = 1e7 + 4.0 * std::max(source.width, source.height);
-              u_out = static_cast<float>(std::clamp(u, -lim, lim));
-              v_out = static_cast<float>(std::clamp(v, -lim, lim));
-              z_out = static_cast<float>(std::min(X.z(), 1e30));
-              if (u >= 0 && v >= 0 && u < source.width && v < source.height &&
-                  SourceSeesDepth(source_depth, u, v, X.z(), tol, invalid)) {
-                ok = 1.f;
-              }
-            }
-          }
-          map.source_xy.data[2 * i] = u_out;
-          map.source_xy.data[2 * i + 1] = v_out;
-          map.source_z.data[i] = z_out;
-          map.valid_warp.data[i] = ok;
-          valid_count += ok > 0;
+          valid_count +=
+              WarpPixel(pixel, R_rel, t_rel, source, source_depth, options, i, &map);
         }
         valid_per_row[y] = valid_count;
       },

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 
 #include "fvs/net/image_tensor.h"
 #include "fvs/util/error.h"
@@ -132,6 +133,93 @@ torch::Tensor FillHolesOf(const torch::Tensor& rgb, const torch::Tensor& covered
   return ImageToTensor(color).to(rgb.device());
 }
 
+namespace {
+
+// The source depth [K, hw] at the source pixels (xx, yy) (whole numbers held as doubles).
+torch::Tensor GatherDepth(const torch::Tensor& depths, int64_t width,
+                          const torch::Tensor& yy, const torch::Tensor& xx) {
+  return torch::gather(depths, 1, (yy * width + xx).to(torch::kLong));
+}
+
+// The occlusion tests of scene/warp.h on [K, hw] source positions (u, v) inside the
+// sources: for a target surface point at source depth z, the source depth at the nearest
+// pixel (no surface = invalid_depth) or interpolated between the 4 nearest pixel centres
+// when all 4 are surface; for a pixel at infinity, no surface at the nearest pixel.
+torch::Tensor SourceSees(const torch::Tensor& depths, int64_t sw, int64_t sh,
+                         const torch::Tensor& u, const torch::Tensor& v,
+                         const torch::Tensor& z, const torch::Tensor& surface,
+                         const WarpSettings& settings) {
+  const double tol = settings.occlusion_tolerance;
+  const torch::Tensor sx = torch::clamp(u.floor(), 0, sw - 1);
+  const torch::Tensor sy = torch::clamp(v.floor(), 0, sh - 1);
+  const torch::Tensor nearest = GatherDepth(depths, sw, sy, sx);
+  const torch::Tensor sees_infinity = nearest <= 0;
+  const torch::Tensor ds = torch::where(
+      nearest > 0, nearest, torch::full_like(nearest, settings.invalid_depth));
+  const torch::Tensor nearest_ok = (z - ds).abs() <= tol * z;
+  // Or the depth interpolated between the 4 nearest pixel centres when all 4 are surface
+  // (a surface seen at a grazing angle changes by more than 1% within one pixel).
+  const torch::Tensor fxs = torch::clamp(u - 0.5, 0.0, sw - 1.0);
+  const torch::Tensor fys = torch::clamp(v - 0.5, 0.0, sh - 1.0);
+  const torch::Tensor x0 = torch::clamp_max(fxs.floor(), std::max<int64_t>(sw - 2, 0));
+  const torch::Tensor y0 = torch::clamp_max(fys.floor(), std::max<int64_t>(sh - 2, 0));
+  const torch::Tensor x1 = torch::clamp_max(x0 + 1, sw - 1),
+                      y1 = torch::clamp_max(y0 + 1, sh - 1);
+  const torch::Tensor ax = fxs - x0, ay = fys - y0;
+  const torch::Tensor d00 = GatherDepth(depths, sw, y0, x0),
+                      d10 = GatherDepth(depths, sw, y0, x1),
+                      d01 = GatherDepth(depths, sw, y1, x0),
+                      d11 = GatherDepth(depths, sw, y1, x1);
+  const torch::Tensor all_surface = (d00 > 0) & (d10 > 0) & (d01 > 0) & (d11 > 0);
+  const torch::Tensor bilinear =
+      (1 - ay) * ((1 - ax) * d00 + ax * d10) + ay * ((1 - ax) * d01 + ax * d11);
+  const torch::Tensor bilinear_ok = all_surface & ((z - bilinear).abs() <= tol * z);
+  return torch::where(surface, nearest_ok | bilinear_ok, sees_infinity);
+}
+
+// The sources as ULR sees them: centres in the target frame, -R_rel^T t_rel, and focal
+// lengths sqrt(fx fy) [K].
+UlrSources TrainingUlrSources(const torch::Tensor& R_rel, const torch::Tensor& t_rel,
+                              const torch::Tensor& focals, double target_focal) {
+  const torch::Tensor centers =
+      -torch::matmul(R_rel.transpose(1, 2), t_rel.unsqueeze(-1)).squeeze(-1);
+  UlrSources ulr;
+  ulr.target_focal = target_focal;
+  for (int64_t s = 0; s < centers.size(0); ++s) {
+    ulr.centers.emplace_back(centers[s][0].item<double>(), centers[s][1].item<double>(),
+                             centers[s][2].item<double>());
+    ulr.focals.push_back(focals[s].item<double>());
+  }
+  return ulr;
+}
+
+// ULR log-weights [K, hw] (UlrLogWeights) at the target's points [hw,3]: surface points
+// as they are, the rays of pixels without a surface (surface [hw], bool) moved to
+// UlrPointAtInfinity as the renderer's UlrSurfacePoint does.
+torch::Tensor TrainingUlrLogWeights(const torch::Tensor& points,
+                                    const torch::Tensor& surface,
+                                    const UlrSources& sources,
+                                    const torch::Tensor& valid_warp,
+                                    const UlrSettings& settings) {
+  const int64_t n = points.size(0), k = sources.size();
+  std::vector<double> pts(points.data_ptr<double>(), points.data_ptr<double>() + 3 * n);
+  const double far_distance = UlrFarDistance(sources);
+  const bool* is_surface = surface.data_ptr<bool>();
+  for (int64_t i = 0; i < n; ++i) {
+    if (is_surface[i]) continue;
+    const Eigen::Vector3d p = UlrPointAtInfinity(
+        Eigen::Vector3d(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]), far_distance);
+    for (int c = 0; c < 3; ++c) pts[3 * i + c] = p[c];
+  }
+  const torch::Tensor sees = valid_warp.reshape({k, n}).contiguous();
+  torch::Tensor log_weights = torch::empty({k, n}, torch::kFloat);
+  UlrLogWeights(pts.data(), n, sources, sees.data_ptr<float>(), settings,
+                log_weights.data_ptr<float>(), /*num_threads=*/1);
+  return log_weights;
+}
+
+}  // namespace
+
 TrainingWarp ComputeTrainingWarp(
     const torch::Tensor& target_K, const torch::Tensor& target_R,
     const torch::Tensor& target_t, const torch::Tensor& target_depth,
@@ -143,7 +231,6 @@ TrainingWarp ComputeTrainingWarp(
   const int64_t h = target_depth.size(0), w = target_depth.size(1);
   const int64_t k = source_K.size(0), sh = source_depths.size(1),
                 sw = source_depths.size(2);
-  const double invalid = settings.invalid_depth;
 
   // Target rays through the pixel centres, in double.
   const torch::Tensor Kt = target_K.to(torch::kDouble).cpu();
@@ -153,8 +240,10 @@ TrainingWarp ComputeTrainingWarp(
   const torch::Tensor ys = (torch::arange(h, f64) + 0.5 - cy) / fy;
   const torch::Tensor raw = target_depth.to(torch::kDouble).cpu();
   const torch::Tensor surface = (raw > 0) & torch::isfinite(raw);
-  const torch::Tensor depth = torch::where(
-      surface, raw, torch::full_like(raw, settings.inf_depth ? invalid : 0.0));
+  const torch::Tensor surface_flat = surface.reshape({1, h * w});
+  // Surface pixels at their depth; the others as their ray (x, y, 1), warped at
+  // infinity: rotated, never translated (scene/warp.h).
+  const torch::Tensor depth = torch::where(surface, raw, torch::ones_like(raw));
   const torch::Tensor points =
       torch::stack({xs.unsqueeze(0).expand({h, w}) * depth,
                     ys.unsqueeze(1).expand({h, w}) * depth, depth},
@@ -169,8 +258,9 @@ TrainingWarp ComputeTrainingWarp(
   const torch::Tensor t_rel =
       source_t.to(torch::kDouble).cpu() -
       torch::matmul(R_rel, tt.reshape({3, 1})).squeeze(-1);  // [K,3]
-  const torch::Tensor X =
-      torch::matmul(points, R_rel.transpose(1, 2)) + t_rel.unsqueeze(1);  // [K,hw,3]
+  const torch::Tensor translated = surface_flat.unsqueeze(-1).to(torch::kDouble);
+  const torch::Tensor X = torch::matmul(points, R_rel.transpose(1, 2)) +
+                          t_rel.unsqueeze(1) * translated;  // [K,hw,3]
   const torch::Tensor z = X.select(2, 2);
   const torch::Tensor norm = X.norm(2, 2);
   const torch::Tensor in_front = z > 1e-12 * torch::clamp_min(norm, 1.0);
@@ -191,34 +281,9 @@ TrainingWarp ComputeTrainingWarp(
   v = torch::where(projects, torch::clamp(torch::nan_to_num(v), -lim, lim),
                    torch::full_like(v, -1.0));
   const torch::Tensor inside = projects & (u >= 0) & (v >= 0) & (u < sw) & (v < sh);
-  // Occlusion test against the source's own depth at the nearest source pixel.
-  const torch::Tensor sx = torch::clamp(u.floor(), 0, sw - 1).to(torch::kLong);
-  const torch::Tensor sy = torch::clamp(v.floor(), 0, sh - 1).to(torch::kLong);
   const torch::Tensor sd = source_depths.to(torch::kDouble).cpu().reshape({k, sh * sw});
-  const double tol = settings.occlusion_tolerance;
-  torch::Tensor ds = torch::gather(sd, 1, sy * sw + sx);
-  ds = torch::where(ds > 0, ds, torch::full_like(ds, invalid));
-  const torch::Tensor nearest_ok = (z - ds).abs() <= tol * z;
-  // Or the depth interpolated between the 4 nearest pixel centres when all 4 are surface
-  // (a surface seen at a grazing angle changes by more than 1% within one pixel).
-  const torch::Tensor fxs = torch::clamp(u - 0.5, 0.0, sw - 1.0);
-  const torch::Tensor fys = torch::clamp(v - 0.5, 0.0, sh - 1.0);
-  const torch::Tensor x0 = torch::clamp_max(fxs.floor(), std::max<int64_t>(sw - 2, 0));
-  const torch::Tensor y0 = torch::clamp_max(fys.floor(), std::max<int64_t>(sh - 2, 0));
-  const torch::Tensor x1 = torch::clamp_max(x0 + 1, sw - 1),
-                      y1 = torch::clamp_max(y0 + 1, sh - 1);
-  const torch::Tensor ax = fxs - x0, ay = fys - y0;
-  auto at = [&](const torch::Tensor& yy, const torch::Tensor& xx) {
-    return torch::gather(sd, 1, (yy * sw + xx).to(torch::kLong));
-  };
-  const torch::Tensor d00 = at(y0, x0), d10 = at(y0, x1), d01 = at(y1, x0),
-                      d11 = at(y1, x1);
-  const torch::Tensor all_surface = (d00 > 0) & (d10 > 0) & (d01 > 0) & (d11 > 0);
-  const torch::Tensor bilinear =
-      (1 - ay) * ((1 - ax) * d00 + ax * d10) + ay * ((1 - ax) * d01 + ax * d11);
-  const torch::Tensor bilinear_ok = all_surface & ((z - bilinear).abs() <= tol * z);
-  torch::Tensor valid = inside & (nearest_ok | bilinear_ok);
-  const torch::Tensor surface_flat = surface.reshape({1, h * w});
+  torch::Tensor valid =
+      inside & SourceSees(sd, sw, sh, u, v, z, surface_flat.expand({k, h * w}), settings);
   if (!settings.inf_depth) {
     valid = valid & surface_flat;
     u = torch::where(surface_flat, u, torch::full_like(u, -1.0));
@@ -232,23 +297,12 @@ TrainingWarp ComputeTrainingWarp(
   out.valid_depth = surface.to(torch::kFloat).reshape({1, 1, h, w});
   out.valid_warp = valid.to(torch::kFloat).reshape({k, 1, h, w});
   if (settings.ulr_log_weights) {
-    // Source centres in the target frame: -R_rel^T t_rel.
-    const torch::Tensor centers =
-        -torch::matmul(R_rel.transpose(1, 2), t_rel.unsqueeze(-1)).squeeze(-1);
-    UlrSources ulr;
-    ulr.target_focal = std::sqrt(fx * fy);
-    const torch::Tensor sf = torch::sqrt(sfx * sfy).reshape({k}).contiguous();
-    for (int64_t s = 0; s < k; ++s) {
-      ulr.centers.emplace_back(centers[s][0].item<double>(), centers[s][1].item<double>(),
-                               centers[s][2].item<double>());
-      ulr.focals.push_back(sf[s].item<double>());
-    }
-    const torch::Tensor pts = points.reshape({h * w, 3}).contiguous();
-    const torch::Tensor sees = out.valid_warp.reshape({k, h * w}).contiguous();
-    torch::Tensor log_weights = torch::empty({k, h * w}, torch::kFloat);
-    UlrLogWeights(pts.data_ptr<double>(), h * w, ulr, sees.data_ptr<float>(),
-                  settings.ulr, log_weights.data_ptr<float>(), /*num_threads=*/1);
-    out.ulr_log_weights = log_weights.reshape({k, 1, h, w});
+    const UlrSources ulr = TrainingUlrSources(
+        R_rel, t_rel, torch::sqrt(sfx * sfy).reshape({k}), std::sqrt(fx * fy));
+    out.ulr_log_weights = TrainingUlrLogWeights(points.reshape({h * w, 3}).contiguous(),
+                                                surface.reshape({h * w}).contiguous(),
+                                                ulr, out.valid_warp, settings.ulr)
+                              .reshape({k, 1, h, w});
   }
   return out;
 }

@@ -46,8 +46,10 @@ std::vector<int> ValidationTargets(const PackedScene& scene, int count);
 
 struct WarpSettings {
   double occlusion_tolerance = 0.01;  // |z - D_source| <= tol * z
-  bool inf_depth = true;              // no-surface target pixels at invalid_depth
-  double invalid_depth = 1e9;
+  // No-surface target pixels warped at infinity (rotation only; scene/warp.h); false:
+  // they are invalid.
+  bool inf_depth = true;
+  double invalid_depth = 1e9;  // what a source pixel without a surface counts as
   // Also compute the ULR log-weights (the prior of ModelConfig::ulr_prior) with these
   // settings.
   bool ulr_log_weights = false;
@@ -67,8 +69,10 @@ struct TrainingWarp {
 // same conventions as fvs::ComputeWarpMap (scene/warp.h): pixel centres at +0.5; the
 // occlusion test passes with the source depth at the nearest source pixel (no surface =
 // invalid_depth) or, failing that, with the depth interpolated between the 4 nearest
-// pixel centres when all 4 are surface. Target pixels without a surface warp from
-// invalid_depth when inf_depth, else are invalid.
+// pixel centres when all 4 are surface. Target pixels without a surface are warped at
+// infinity (rotation only, seen where the source has no surface either) when inf_depth,
+// else are invalid. The ULR log-weights weigh them at UlrPointAtInfinity, as the
+// renderer does.
 TrainingWarp ComputeTrainingWarp(
     const torch::Tensor& target_K, const torch::Tensor& target_R,
     const torch::Tensor& target_t, const torch::Tensor& target_depth,
