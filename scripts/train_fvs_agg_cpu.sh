@@ -80,7 +80,10 @@ done
 printf "packed/middlebury_temple\npacked/fox\npacked/monstree\n" > val.txt
 ls -d packed/*/ | sed 's#/$##' | grep -v -e middlebury_temple -e /fox -e /monstree > train.txt
 
-exec nice -n "$NICE" env FVS_NUM_THREADS="$(nproc)" FVS_LPIPS_PATH="$LPIPS" \
+# Passive OpenMP waits: with anything else running, spinning threads that wait for a core
+# made steps several times slower on this 2-core machine.
+exec nice -n "$NICE" env FVS_NUM_THREADS="${FVS_NUM_THREADS:-$(nproc)}" \
+  OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-PASSIVE}" FVS_LPIPS_PATH="$LPIPS" \
   bin/colmap view_synthesis_train \
   --scene_list train.txt --val_scene_list val.txt --output_path runs/fvs_agg \
   --Train.variant fvs_agg --Train.crop 128 --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
