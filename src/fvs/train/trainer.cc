@@ -116,6 +116,22 @@ void DivideSums(int views, Sums* s) {
     *v /= views;
   }
 }
+
+// The card's figures of a scene or of all scenes.
+template <typename Sums>
+nlohmann::json QualityJson(const Sums& s, bool has_lpips) {
+  nlohmann::json j = {{"psnr", s.psnr},
+                      {"ssim", s.ssim},
+                      {"ulr_psnr", s.ulr_psnr},
+                      {"ulr_ssim", s.ulr_ssim},
+                      {"seconds_per_view", s.seconds_per_view}};
+  if (has_lpips) {
+    j["lpips"] = s.lpips;
+    j["ulr_lpips"] = s.ulr_lpips;
+  }
+  return j;
+}
+
 void AddSums(const ValidationResult::Scene& scene, ValidationResult* all) {
   all->psnr += scene.psnr;
   all->ssim += scene.ssim;
@@ -400,28 +416,12 @@ std::string Trainer::SaveModel() {
   card["data"] = {{"train", scene_list(train_scenes_)},
                   {"validation", scene_list(val_scenes_)}};
   if (has_validation_) {
-    nlohmann::json v = {{"step", last_validation_.step},
-                        {"psnr", last_validation_.psnr},
-                        {"ssim", last_validation_.ssim},
-                        {"ulr_psnr", last_validation_.ulr_psnr},
-                        {"ulr_ssim", last_validation_.ulr_ssim},
-                        {"seconds_per_view", last_validation_.seconds_per_view}};
-    if (last_validation_.has_lpips) {
-      v["lpips"] = last_validation_.lpips;
-      v["ulr_lpips"] = last_validation_.ulr_lpips;
-    }
+    nlohmann::json v = QualityJson(last_validation_, last_validation_.has_lpips);
+    v["step"] = last_validation_.step;
     for (const auto& r : last_validation_.scenes) {
-      nlohmann::json scene = {{"path", r.path},
-                              {"views", r.views},
-                              {"psnr", r.psnr},
-                              {"ssim", r.ssim},
-                              {"ulr_psnr", r.ulr_psnr},
-                              {"ulr_ssim", r.ulr_ssim},
-                              {"seconds_per_view", r.seconds_per_view}};
-      if (last_validation_.has_lpips) {
-        scene["lpips"] = r.lpips;
-        scene["ulr_lpips"] = r.ulr_lpips;
-      }
+      nlohmann::json scene = QualityJson(r, last_validation_.has_lpips);
+      scene["path"] = r.path;
+      scene["views"] = r.views;
       v["scenes"].push_back(scene);
     }
     card["validation"] = v;
