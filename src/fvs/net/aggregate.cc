@@ -106,7 +106,9 @@ BlendOutput AggregateBlenderImpl::forward(const torch::Tensor& warped,
   h = torch::relu(s_context_(torch::relu(s_mix_(torch::cat({h, Up2(d)}, 1)))));
   // Across sources: mean and max of the seeing sources' states, given to every source.
   const torch::Tensor vp = PadEven(v);
-  const torch::Tensor pooled_mean = (h * vp).sum(0, true) / PadEven(count);
+  // Clamped after padding: a 0/0 in the padding would be cropped from the output but
+  // not from the weights' gradients.
+  const torch::Tensor pooled_mean = (h * vp).sum(0, true) / PadEven(seeing).clamp_min(1.0);
   const torch::Tensor pooled_max = std::get<0>((h * vp).max(0, true));
   h = torch::relu(s_pool_(
       torch::cat({h, per_source(pooled_mean), per_source(pooled_max)}, 1)));
