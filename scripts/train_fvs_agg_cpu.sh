@@ -87,5 +87,5 @@ exec nice -n "$NICE" env FVS_NUM_THREADS="${FVS_NUM_THREADS:-$(nproc)}" \
   bin/colmap view_synthesis_train \
   --scene_list train.txt --val_scene_list val.txt --output_path runs/fvs_agg \
   --Train.variant fvs_agg --Train.crop 128 --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
-  --Train.batch_size 4 --Train.learning_rate 1e-3 --Train.val_every 250 \
+  --Train.batch_size 4 --Train.learning_rate "${FVS_LR:-2e-4}" --Train.val_every 250 \
   --Train.val_views 4 --Train.log_every 25 --Train.checkpoint_minutes 10

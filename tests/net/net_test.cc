@@ -50,6 +50,20 @@ Inputs MakeInputs(int k, int target_h, int target_w, int source_h = 37,
   return in;
 }
 
+// One training forward and backward on random inputs; every parameter must get a finite
+// gradient.
+void ExpectFiniteGradients(FvsNet& net, const Inputs& in) {
+  net->train();
+  net->zero_grad();
+  const BlendOutput out =
+      net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp, in.ulr);
+  (out.rgb - 0.5).abs().mean().backward();
+  for (const auto& p : net->named_parameters()) {
+    ASSERT_TRUE(p.value().grad().defined()) << p.key();
+    EXPECT_TRUE(torch::isfinite(p.value().grad()).all().item<bool>()) << p.key();
+  }
+}
+
 TEST(ModelConfigTest, VariantsAndJson) {
   for (const std::string& name : ModelConfig::KnownVariants()) {
     const ModelConfig c = ModelConfig::ForVariant(name);
@@ -261,18 +275,8 @@ TEST(FvsAggTest, StartsAsTheUlrBlendAndLearnsEverywhere) {
     EXPECT_THROW(net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp), Error);
   }
   // Every parameter gets a finite gradient, K = 1 included.
-  for (int k : {1, 3}) {
-    net->train();
-    net->zero_grad();
-    const Inputs x = MakeInputs(k, 16, 21, 20, 28);
-    const BlendOutput out =
-        net->Forward(x.images, x.grid, x.valid_depth, x.valid_warp, x.ulr);
-    (out.rgb - 0.5).abs().mean().backward();
-    for (const auto& p : net->named_parameters()) {
-      ASSERT_TRUE(p.value().grad().defined()) << p.key();
-      EXPECT_TRUE(torch::isfinite(p.value().grad()).all().item<bool>()) << p.key();
-    }
-  }
+  // Odd sizes on purpose: the padded pixels must not reach the gradients.
+  for (int k : {1, 3}) ExpectFiniteGradients(net, MakeInputs(k, 16, 21, 20, 28));
   // Bad layouts are refused with a reason.
   EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_agg","encoder_channels":[8,16]})"),
                Error);
@@ -444,15 +448,7 @@ TEST(FvsNetTest, TrainingGivesFiniteGradientsEverywhere) {
   for (const ModelConfig& config : {ModelConfig::ForVariant("fvs_fast"), separable}) {
     torch::manual_seed(6);
     FvsNet net(config);
-    net->train();
-    const Inputs in = MakeInputs(2, 16, 24, 20, 28);
-    const BlendOutput out =
-        net->Forward(in.images, in.grid, in.valid_depth, in.valid_warp, in.ulr);
-    (out.rgb - 0.5).abs().mean().backward();
-    for (const auto& p : net->named_parameters()) {
-      ASSERT_TRUE(p.value().grad().defined()) << p.key();
-      EXPECT_TRUE(torch::isfinite(p.value().grad()).all().item<bool>()) << p.key();
-    }
+    ExpectFiniteGradients(net, MakeInputs(2, 16, 24, 20, 28));
   }
   // Separable units: a depthwise 3x3 without bias and a pointwise 1x1 (far fewer
   // weights).
