@@ -15,9 +15,11 @@ DATASETS="$(realpath "${1:-../shared/datasets}")"
 WORK="${2:-/work/fvs_training}"
 NICE="${FVS_NICE:-19}"  # niceness of every stage
 COLMAP="$PWD/build/bin/colmap"
-# L1 + LPIPS-alex (the perceptual loss that can be had here) when the weights are there.
+# LPIPS-alex (the perceptual loss that can be had here) when the weights are there.
 LPIPS="${FVS_LPIPS_PATH:-$(realpath -m ../shared/weights/lpips_alex.safetensors)}"
 [[ -f "$LPIPS" ]] || LPIPS=""
+# L1 + (1 - SSIM) + LPIPS: LPIPS alone traded SSIM for texture (doc/training.md).
+LOSS="${FVS_LOSS:-$([[ -n "$LPIPS" ]] && echo l1+ssim+lpips || echo l1+ssim)}"
 [[ -x "$COLMAP" ]] || scripts/build.sh
 mkdir -p "$WORK"/{bin,images,ws,packed,runs}
 # A copy, so that rebuilding build/ never changes the binary under a running stage.
@@ -88,4 +90,4 @@ exec nice -n "$NICE" env FVS_NUM_THREADS="${FVS_NUM_THREADS:-$(nproc)}" \
   --scene_list train.txt --val_scene_list val.txt --output_path runs/fvs_agg \
   --Train.variant fvs_agg --Train.crop 128 --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
   --Train.batch_size 4 --Train.learning_rate "${FVS_LR:-2e-4}" --Train.val_every 250 \
-  --Train.val_views 4 --Train.log_every 25 --Train.checkpoint_minutes 10
+  --Train.val_views 4 --Train.log_every 25 --Train.checkpoint_minutes 10 --Train.loss "$LOSS"

@@ -77,6 +77,15 @@ TEST(LpipsLoss, ZeroForEqualImagesAndFallsAlongItsGradient) {
   TrainingLoss doubled(options, torch::kCPU);
   const torch::Tensor other = Pattern(64, 0.4);
   EXPECT_NEAR(doubled(other, target).second, 2 * loss(other, target).second, 1e-5);
+
+  // L1 + (1 - SSIM) + LPIPS: the second term is the sum of both.
+  options.lpips_weight = 1.0;
+  options.kind = "l1+ssim+lpips";
+  TrainingLoss both(options, torch::kCPU);
+  EXPECT_EQ(both.SecondTermName(), "1-ssim+lpips");
+  EXPECT_EQ(both(target, target).second, 0.0);
+  EXPECT_NEAR(both(other, target).second,
+              loss(other, target).second + 1.0 - Ssim(other, target).item<double>(), 1e-5);
 }
 
 TEST(LpipsLoss, AutoPrefersVgg19ThenLpipsThenSsim) {
@@ -87,6 +96,9 @@ TEST(LpipsLoss, AutoPrefersVgg19ThenLpipsThenSsim) {
   testing::ExpectError(
       [] { ChooseLoss("l1+lpips", false, false); },
       {"--Train.loss", "l1+lpips needs LPIPS weights", "FVS_LPIPS_PATH"});
+  EXPECT_EQ(ChooseLoss("l1+ssim+lpips", false, true), "l1+ssim+lpips");
+  testing::ExpectError([] { ChooseLoss("l1+ssim+lpips", false, false); },
+                       {"l1+ssim+lpips needs LPIPS weights"});
   testing::ExpectError([] { ChooseLoss("l1+vgg19", false, true); },
                        {"--Train.loss", "--vgg19_path"});
   LossOptions no_network;

@@ -42,7 +42,7 @@ TORCH_MODULE(Vgg19Features);
 struct LossValue {
   torch::Tensor total;  // differentiable scalar: l1 + second
   double l1 = 0;
-  double second = 0;  // 1 - SSIM, w x LPIPS, or the VGG19 term
+  double second = 0;  // 1 - SSIM, w x LPIPS, both, or the VGG19 term
 };
 
 // The loss of a run: `requested` (auto, l1+ssim, l1+lpips, l1+vgg19) made concrete.
@@ -50,9 +50,12 @@ struct LossValue {
 // l1+lpips when LPIPS weights are loaded, else l1+ssim. Throws fvs::Error when an
 // explicit choice lacks its weights.
 std::string ChooseLoss(const std::string& requested, bool have_vgg19, bool have_lpips);
+// l1+lpips and l1+ssim+lpips (L1 + (1 - SSIM) + w x LPIPS) need the LPIPS network.
+bool LossUsesLpips(const std::string& kind);
 
 struct LossOptions {
-  std::string kind = "l1+ssim";  // l1+ssim, l1+lpips or l1+vgg19 (ChooseLoss)
+  // l1+ssim, l1+lpips, l1+ssim+lpips or l1+vgg19 (ChooseLoss)
+  std::string kind = "l1+ssim";
   std::string vgg19_path;        // l1+vgg19: the weights file
   LpipsNet lpips{nullptr};       // l1+lpips: the loaded network (validation shares it)
   double lpips_weight = 1.0;

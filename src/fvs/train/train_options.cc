@@ -39,9 +39,9 @@ std::vector<OptionSpec> Specs(TrainOptions* o) {
        "and the default loss is L1 + LPIPS"},
       {"Train.loss", Kind::kString, &o->loss, false,
        "auto (l1+vgg19 with --vgg19_path, else l1+lpips with LPIPS weights, else "
-       "l1+ssim), l1+ssim, l1+lpips or l1+vgg19"},
+       "l1+ssim), l1+ssim, l1+lpips, l1+ssim+lpips or l1+vgg19"},
       {"Train.lpips_weight", Kind::kDouble, &o->lpips_weight, false,
-       "weight of the LPIPS term of l1+lpips"},
+       "weight of the LPIPS term of l1+lpips and l1+ssim+lpips"},
       {"Train.variant", Kind::kString, &o->variant, false, "network variant"},
       {"Train.device", Kind::kString, &o->device, false, "auto | cpu | cuda"},
       {"Train.max_steps", Kind::kInt, &o->max_steps, false, "optimiser steps in all"},
@@ -138,9 +138,11 @@ void TrainOptions::Check() const {
   Require(occlusion_tolerance > 0, kSubject, "--Train.occlusion_tolerance must be > 0");
   Require(device == "auto" || device == "cpu" || device == "cuda", kSubject,
           "--Train.device must be auto, cpu or cuda");
-  Require(loss == "auto" || loss == "l1+ssim" || loss == "l1+lpips" || loss == "l1+vgg19",
+  Require(loss == "auto" || loss == "l1+ssim" || loss == "l1+lpips" ||
+              loss == "l1+ssim+lpips" || loss == "l1+vgg19",
           kSubject,
-          "--Train.loss must be auto, l1+ssim, l1+lpips or l1+vgg19, not '" + loss + "'");
+          "--Train.loss must be auto, l1+ssim, l1+lpips, l1+ssim+lpips or l1+vgg19, not '" +
+              loss + "'");
   Require(loss != "l1+vgg19" || !vgg19_path.empty(), kSubject,
           "--Train.loss l1+vgg19 needs --vgg19_path");
   Require(lpips_weight > 0, kSubject, "--Train.lpips_weight must be positive");

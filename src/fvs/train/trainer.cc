@@ -256,8 +256,8 @@ void Trainer::LoadLpipsWeights() {
   if (!std::filesystem::is_regular_file(lpips_path_, ec)) {
     // Asked for by name: an error. Only a default (auto, perhaps from the environment):
     // the run goes on without LPIPS and says so.
-    Require(options_.loss != "l1+lpips", lpips_path_,
-            "no such file (the LPIPS weights of --Train.loss l1+lpips)");
+    Require(!LossUsesLpips(options_.loss), lpips_path_,
+            "no such file (the LPIPS weights of --Train.loss " + options_.loss + ")");
     std::cerr << "[train] WARNING: " << lpips_path_
               << ": no such file; no LPIPS in the loss or the validation\n";
     lpips_path_.clear();
@@ -386,7 +386,7 @@ std::string Trainer::SaveModel() {
   card["variant"] = config_.variant;
   card["config"] = nlohmann::json::parse(config_.ToJson());
   card["loss"] = loss_->Name();
-  if (loss_->Name() == "l1+lpips") card["lpips_weight"] = options_.lpips_weight;
+  if (LossUsesLpips(loss_->Name())) card["lpips_weight"] = options_.lpips_weight;
   if (!lpips_path_.empty()) card["lpips_weights"] = lpips_path_;
   card["steps"] = step_;
   card["batch_size"] = options_.batch_size;
