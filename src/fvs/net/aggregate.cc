@@ -33,6 +33,15 @@ torch::Tensor Down2(const torch::Tensor& x) {
   return F::avg_pool2d(x, F::AvgPool2dFuncOptions(2));
 }
 
+// Context at half resolution (down1, down2), up-sampled and mixed back into x at full
+// resolution (1x1 mix, then one 3x3: alignment is a matter of pixels). x has even sizes.
+torch::Tensor WithHalfResolutionContext(const torch::Tensor& x, ConvUnit& down1,
+                                        ConvUnit& down2, ConvUnit& mix,
+                                        ConvUnit& context) {
+  const torch::Tensor d = torch::relu(down2(torch::relu(down1(Down2(x)))));
+  return torch::relu(context(torch::relu(mix(torch::cat({x, Up2(d)}, 1)))));
+}
+
 void ZeroInit(ConvUnit& unit) {
   torch::NoGradGuard no_grad;
   for (auto& p : unit->parameters()) p.zero_();
@@ -82,7 +91,8 @@ BlendOutput AggregateBlenderImpl::forward(const torch::Tensor& warped,
   const torch::Tensor vd = valid_depth.to(opts);
   const torch::Tensor ulr_log = ulr_log_weights.to(opts);
   // Colours the blend offers: black where the source does not see the pixel (as `ulr`).
-  const torch::Tensor offered = torch::where(v > 0.5, warped, torch::full_like(warped, -1));
+  const torch::Tensor offered =
+      torch::where(v > 0.5, warped, torch::full_like(warped, -1));
   const torch::Tensor colour = warped * v;
   const torch::Tensor ulr_weights = SoftmaxWeights(ulr_prior_ * ulr_log);
   const torch::Tensor ulr = (ulr_weights * offered).sum(0, true);  // [1,3,H,W]
@@ -96,25 +106,22 @@ BlendOutput AggregateBlenderImpl::forward(const torch::Tensor& warped,
 
   // Per-source stack; log-weights scaled so that the floor (-9.2) is about -1.
   const double log_floor = -std::log(kUlrWeightFloor);
-  torch::Tensor x = torch::cat({colour, v, ulr_log / log_floor, ulr_weights,
-                                (warped - ulr) * v, per_source(ulr),
-                                per_source(deviation), per_source(vd),
-                                per_source(share)},
-                               1);
+  torch::Tensor x = torch::cat(
+      {colour, v, ulr_log / log_floor, ulr_weights, (warped - ulr) * v, per_source(ulr),
+       per_source(deviation), per_source(vd), per_source(share)},
+      1);
   x = PadEven(x);
-  // Per pixel at full resolution, context at half resolution, then one full-resolution
-  // 3x3 (alignment is a matter of pixels).
-  torch::Tensor h = torch::relu(s_in_(x));
-  const torch::Tensor d = torch::relu(s_down2_(torch::relu(s_down1_(Down2(h)))));
-  h = torch::relu(s_context_(torch::relu(s_mix_(torch::cat({h, Up2(d)}, 1)))));
+  torch::Tensor h = WithHalfResolutionContext(torch::relu(s_in_(x)), s_down1_, s_down2_,
+                                              s_mix_, s_context_);
   // Across sources: mean and max of the seeing sources' states, given to every source.
   const torch::Tensor vp = PadEven(v);
   // Clamped after padding: a 0/0 in the padding would be cropped from the output but
   // not from the weights' gradients.
-  const torch::Tensor pooled_mean = (h * vp).sum(0, true) / PadEven(seeing).clamp_min(1.0);
+  const torch::Tensor pooled_mean =
+      (h * vp).sum(0, true) / PadEven(seeing).clamp_min(1.0);
   const torch::Tensor pooled_max = std::get<0>((h * vp).max(0, true));
-  h = torch::relu(s_pool_(
-      torch::cat({h, per_source(pooled_mean), per_source(pooled_max)}, 1)));
+  h = torch::relu(
+      s_pool_(torch::cat({h, per_source(pooled_mean), per_source(pooled_max)}, 1)));
   h = CropTo(h, height, width);
 
   BlendOutput out;
@@ -124,9 +131,8 @@ BlendOutput AggregateBlenderImpl::forward(const torch::Tensor& warped,
 
   // Refiner: a residual on the blended image.
   torch::Tensor r = PadEven(torch::cat({blend, ulr, deviation, vd, share}, 1));
-  r = torch::relu(r_in_(r));
-  const torch::Tensor rd = torch::relu(r_down2_(torch::relu(r_down1_(Down2(r)))));
-  r = torch::relu(r_context_(torch::relu(r_mix_(torch::cat({r, Up2(rd)}, 1)))));
+  r = WithHalfResolutionContext(torch::relu(r_in_(r)), r_down1_, r_down2_, r_mix_,
+                                r_context_);
   out.rgb = blend + CropTo(r_out_(r), height, width);
   return out;
 }

@@ -27,11 +27,12 @@ torch::Tensor PixelOracle(const torch::Tensor& colours, const torch::Tensor& see
                           const torch::Tensor& photo) {
   const torch::Tensor error =
       (colours - photo).abs().sum(1, true) + (1 - seen) * 1e6;  // [K,1,H,W]
-  const torch::Tensor best = error.argmin(0, true);              // [1,1,H,W]
+  const torch::Tensor best = error.argmin(0, true);             // [1,1,H,W]
   return colours.gather(0, best.expand({1, 3, -1, -1}));
 }
 
-// K global weights (softmax of free parameters) fitted to the photo on the covered pixels.
+// K global weights (softmax of free parameters) fitted to the photo on the covered
+// pixels.
 torch::Tensor GlobalOracle(const torch::Tensor& colours, const torch::Tensor& seen,
                            const torch::Tensor& photo, const torch::Tensor& covered) {
   const int64_t k = colours.size(0);
