@@ -20,7 +20,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fvs/render/fvs_method.h"
 #include "fvs/render/method.h"
+#include "fvs/scene/scene.h"
 #include "ui/path_panel.h"
 #include "ui/result_panel.h"
 #include "ui/scene_view.h"
@@ -355,10 +357,11 @@ QString MainWindow::CannotRenderReason(const RenderRequest& request) const {
     return "Rendering is not available: " +
            QString::fromStdString(contents_->render_error);
   }
-  if (MethodNeedsWeights(request.method) && request.model_path.empty()) {
+  if (MethodNeedsWeights(request.method) && request.model_path.empty() &&
+      DefaultModelPath(request.method, request.scene_model_dir).empty()) {
     return QString::fromStdString(request.method) +
-           " needs network weights: choose a .safetensors file under Weights (none are "
-           "shipped yet; ulr and nearest need none).";
+           " needs network weights: choose a .safetensors file under Weights (no shipped "
+           "or fine-tuned ones for this method; ulr and nearest need none).";
   }
   try {
     request.Check();
@@ -377,6 +380,7 @@ RenderRequest MainWindow::CurrentRequest() const {
   request.model_path = model_path_->text().trimmed().toStdString();
   if (contents_ && MethodNeedsWeights(request.method)) {
     request.feature_cache_dir = WorkspaceFeatureCacheDir(contents_->path);
+    request.scene_model_dir = WorkspaceFinetunedModelDir(contents_->path);
   }
   return request;
 }

@@ -19,6 +19,7 @@ RenderOptions RenderRequest::ToRenderOptions() const {
   options.num_sources = num_sources;
   options.model_path = model_path;
   options.feature_cache_dir = feature_cache_dir;
+  options.scene_model_dir = scene_model_dir;
   return options;
 }
 

@@ -21,6 +21,7 @@ struct RenderRequest {
   // fvs/features): each render creates its method afresh, so without it every click
   // would encode every source again. Empty = none.
   std::string feature_cache_dir;
+  std::string scene_model_dir;  // a scene's fine-tuned weights (RenderOptions)
   // Throws fvs::Error naming the setting that is out of range.
   void Check() const;
   RenderOptions ToRenderOptions() const;

@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "fvs/train/data.h"
 #include "fvs/train/loss.h"
@@ -169,6 +170,49 @@ TEST_F(TrainerTest, ResumedRunIsBitIdenticalToAnUninterruptedOne) {
   ModelConfig config;
   FvsNet loaded = LoadModel(a.model_path, &config);
   EXPECT_EQ(config.ToJson(), ModelConfig::FromJson(kTinyNet).ToJson());
+}
+
+// M/best.safetensors follows the best validation (and its card says which step);
+// --Train.init_weights starts from given weights; --Train.max_train_minutes stops the run
+// with a model written.
+TEST_F(TrainerTest, BestModelInitWeightsAndTimeBudget) {
+  TrainOptions o = Options("best");
+  o.val_scene_list = dir_->path() + "/val.txt";
+  o.val_every = 1;
+  o.val_views = 2;
+  const TrainSummary a = RunTraining(o);
+  ASSERT_TRUE(std::filesystem::is_regular_file(o.output_path + "/best.safetensors"));
+  const nlohmann::json best =
+      nlohmann::json::parse(ReadFileToString(o.output_path + "/best.json"));
+  const int best_step = best.at("validation").at("step").get<int>();
+  EXPECT_GE(best_step, 1);
+  EXPECT_LE(best_step, a.steps_done);
+  EXPECT_NE(ReadFileToString(o.output_path + "/validation.csv")
+                .find("\n" + std::to_string(best_step) + ",all,"),
+            std::string::npos);
+
+  // Starting from weights: one step of a vanishing step size (Adam moves each weight by
+  // about the step size) leaves exactly those weights; the budget stopped the run, a
+  // model was written and its card names the weights.
+  TrainOptions init = Options("init");
+  init.init_weights = a.model_path;
+  init.learning_rate = 1e-12;
+  init.max_train_minutes = 1e-9;
+  const TrainSummary b = RunTraining(init);
+  EXPECT_EQ(b.steps_done, 1);
+  ASSERT_FALSE(b.model_path.empty());
+  ModelConfig config_a, config_b;
+  FvsNet na = LoadModel(a.model_path, &config_a), nb = LoadModel(b.model_path, &config_b);
+  EXPECT_EQ(config_a.ToJson(), config_b.ToJson());
+  const auto pa = na->parameters(), pb = nb->parameters();
+  ASSERT_EQ(pa.size(), pb.size());
+  for (size_t i = 0; i < pa.size(); ++i)
+    EXPECT_TRUE(torch::allclose(pa[i], pb[i], 0, 1e-6)) << i;
+  EXPECT_NE(ReadFileToString(init.output_path + "/model.json").find("\"init_weights\""),
+            std::string::npos);
+  init.init_weights = dir_->path() + "/no_such.safetensors";
+  init.output_path = dir_->path() + "/init_missing";
+  EXPECT_THROW(RunTraining(init), Error);
 }
 
 TEST_F(TrainerTest, CorruptNewestCheckpointFallsBackToThePrevious) {

@@ -260,6 +260,7 @@ int RunViewSynthesis(int argc, char** argv) {
                      "i/n: render only targets i, i+n, i+2n, ... (Slurm/Kubernetes array "
                      "jobs; file names stay those of the full path)");
   if (!options.Parse(argc, argv)) return 0;
+  o.render.scene_model_dir = WorkspaceFinetunedModelDir(o.workspace_path);
   if (o.disk_feature_cache) {
     o.render.feature_cache_dir = WorkspaceFeatureCacheDir(o.workspace_path);
   }

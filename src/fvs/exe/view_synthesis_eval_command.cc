@@ -160,6 +160,7 @@ int RunViewSynthesisEval(int argc, char** argv) {
   run.render.num_threads = o.num_threads;
   run.render.fill_holes = o.fill_holes;
   run.render.device = o.device;
+  run.render.scene_model_dir = WorkspaceFinetunedModelDir(o.workspace_path);
   run.render.Check();
   if (o.sweep) {
     SweepOptions sweep = o.sweep_options;

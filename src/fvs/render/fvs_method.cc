@@ -109,7 +109,8 @@ class FvsMethod : public Method {
     for (auto& p : net_->parameters()) {
       if (p.dim() == 4) p.set_data(p.contiguous(torch::MemoryFormat::ChannelsLast));
     }
-    // A network without an encoder (fvs_agg) warps the photos themselves: nothing to keep.
+    // A network without an encoder (fvs_agg) warps the photos themselves: nothing to
+    // keep.
     if (!options_.feature_cache_dir.empty() && !config_.encoder_channels.empty()) {
       try {  // an optimisation: a read-only workspace renders, only slower
         store_ = std::make_unique<FeatureStore>(
@@ -289,18 +290,42 @@ std::string ShippedModelPath(const std::string& variant) {
   return "";
 }
 
+std::string DefaultModelPath(const std::string& variant,
+                             const std::string& scene_model_dir, bool* is_scene_model) {
+  namespace fs = std::filesystem;
+  if (is_scene_model) *is_scene_model = false;
+  if (!scene_model_dir.empty()) {
+    const fs::path file = fs::path(scene_model_dir) / (variant + ".safetensors");
+    std::error_code error;
+    if (fs::is_regular_file(file, error)) {
+      if (is_scene_model) *is_scene_model = true;
+      return file.string();
+    }
+  }
+  return ShippedModelPath(variant);
+}
+
 std::unique_ptr<Method> CreateFvsMethod(const std::string& requested,
                                         const RenderOptions& options_in) {
   RenderOptions options = options_in;
   if (options.model_path.empty()) {
-    options.model_path = ShippedModelPath(requested);
+    bool scene_model = false;
+    options.model_path =
+        DefaultModelPath(requested, options.scene_model_dir, &scene_model);
     if (options.model_path.empty()) {
       throw Error("--method " + requested,
                   "method " + requested +
                       " needs model weights: --model_path <weights.safetensors> (no "
-                      "shipped " + requested + " model found; models/README.md)");
+                      "shipped " +
+                      requested + " model found; models/README.md)");
     }
-    std::cerr << "using the shipped model " << options.model_path << "\n";
+    std::cerr << (scene_model ? "using the scene's fine-tuned model "
+                              : "using the shipped model ")
+              << options.model_path
+              << (scene_model
+                      ? " (view_synthesis_finetune; --model_path for other weights)"
+                      : "")
+              << "\n";
   }
   ConfigureTorchThreads();
   const bool have_cuda = torch::cuda::is_available();

@@ -22,4 +22,11 @@ std::unique_ptr<Method> CreateFvsMethod(const std::string& requested,
 // source tree's models/ (a build-tree binary). Empty when none has them.
 std::string ShippedModelPath(const std::string& variant);
 
+// The weights a network method uses without --model_path: the scene's fine-tuned
+// <variant>.safetensors in scene_model_dir when there is one, else ShippedModelPath.
+// *is_scene_model (optional) tells which. Empty when there are none.
+std::string DefaultModelPath(const std::string& variant,
+                             const std::string& scene_model_dir,
+                             bool* is_scene_model = nullptr);
+
 }  // namespace fvs

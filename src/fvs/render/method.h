@@ -43,6 +43,9 @@ struct RenderOptions {
   int ulr_num_blend = 4;   // ULR k-nearest: best sources blended per pixel
   int num_threads = 0;     // <= 0: DefaultNumThreads()
   std::string model_path;  // weights, for methods that need them
+  // Network methods without model_path: <variant>.safetensors in this folder (a scene's
+  // fine-tuned weights, WorkspaceFinetunedModelDir(W)) comes before the shipped model.
+  std::string scene_model_dir;
   // Temporal stability (videos). A preferred source (TargetView::preferred_sources) ranks
   // with its count times (1 + source_hysteresis): it stays in the top K until another
   // source sees that much more. 0 = off (each frame on its own).

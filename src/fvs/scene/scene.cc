@@ -162,4 +162,8 @@ Scene Scene::Load(const std::string& workspace_path, const SceneLoadOptions& opt
   return scene;
 }
 
+std::string WorkspaceFinetunedModelDir(const std::string& workspace_path) {
+  return (std::filesystem::path(workspace_path) / "fvs" / "finetuned").string();
+}
+
 }  // namespace fvs

@@ -99,4 +99,9 @@ class Scene {
   friend class SceneLoader;
 };
 
+// W/fvs/finetuned: a scene's own weights (<variant>.safetensors and .json), written by
+// view_synthesis_finetune (train/finetune.h) and used by the renderer before the shipped
+// ones.
+std::string WorkspaceFinetunedModelDir(const std::string& workspace_path);
+
 }  // namespace fvs

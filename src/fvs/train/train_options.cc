@@ -43,6 +43,12 @@ std::vector<OptionSpec> Specs(TrainOptions* o) {
       {"Train.lpips_weight", Kind::kDouble, &o->lpips_weight, false,
        "weight of the LPIPS term of l1+lpips and l1+ssim+lpips"},
       {"Train.variant", Kind::kString, &o->variant, false, "network variant"},
+      {"Train.init_weights", Kind::kString, &o->init_weights, false,
+       "start from these weights (.safetensors; their variant) instead of a fresh "
+       "network (a checkpoint in the output folder still resumes first)"},
+      {"Train.max_train_minutes", Kind::kDouble, &o->max_train_minutes, false,
+       "> 0: also stop and write the model once the training time of all invocations "
+       "reaches this"},
       {"Train.device", Kind::kString, &o->device, false, "auto | cpu | cuda"},
       {"Train.max_steps", Kind::kInt, &o->max_steps, false, "optimiser steps in all"},
       {"Train.num_sources", Kind::kInt, &o->num_sources, false,
@@ -121,6 +127,7 @@ void TrainOptions::Check() const {
   Require(!scene_list.empty(), kSubject, "--scene_list is required");
   Require(!output_path.empty(), kSubject, "--output_path is required");
   Require(max_steps > 0, kSubject, "--Train.max_steps must be positive");
+  Require(max_train_minutes >= 0, kSubject, "--Train.max_train_minutes must be >= 0");
   Require(num_sources >= 1, kSubject, "--Train.num_sources must be at least 1");
   Require(crop >= 16, kSubject, "--Train.crop must be at least 16 (SSIM window)");
   Require(batch_size >= 1, kSubject, "--Train.batch_size must be at least 1");
@@ -138,11 +145,12 @@ void TrainOptions::Check() const {
   Require(occlusion_tolerance > 0, kSubject, "--Train.occlusion_tolerance must be > 0");
   Require(device == "auto" || device == "cpu" || device == "cuda", kSubject,
           "--Train.device must be auto, cpu or cuda");
-  Require(loss == "auto" || loss == "l1+ssim" || loss == "l1+lpips" ||
-              loss == "l1+ssim+lpips" || loss == "l1+vgg19",
-          kSubject,
-          "--Train.loss must be auto, l1+ssim, l1+lpips, l1+ssim+lpips or l1+vgg19, not '" +
-              loss + "'");
+  Require(
+      loss == "auto" || loss == "l1+ssim" || loss == "l1+lpips" ||
+          loss == "l1+ssim+lpips" || loss == "l1+vgg19",
+      kSubject,
+      "--Train.loss must be auto, l1+ssim, l1+lpips, l1+ssim+lpips or l1+vgg19, not '" +
+          loss + "'");
   Require(loss != "l1+vgg19" || !vgg19_path.empty(), kSubject,
           "--Train.loss l1+vgg19 needs --vgg19_path");
   Require(lpips_weight > 0, kSubject, "--Train.lpips_weight must be positive");

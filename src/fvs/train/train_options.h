@@ -22,8 +22,14 @@ struct TrainOptions {
   std::string loss = "auto";
   double lpips_weight = 1.0;  // of the LPIPS term of l1+lpips
   std::string variant = "fvs";
+  // Start from these weights (their own variant and layout) instead of a fresh network;
+  // a checkpoint in M still wins (resume). Fine-tuning (train/finetune.h) uses it.
+  std::string init_weights;
   std::string device = "auto";  // auto | cpu | cuda
   int max_steps = 100000;
+  // > 0: also stop, writing the model as at max_steps, once the run's training time (all
+  // invocations, the card's "hours") reaches this many minutes.
+  double max_train_minutes = 0;
   int num_sources = 5;
   int crop = 192;
   // Pixels kept around the part of each source a target crop samples: the encoder runs

@@ -192,6 +192,33 @@ void PrintValidation(int step, int total_views, const ValidationResult& result) 
             << " views); ulr on the same views: " << ulr.str() << "\n";
 }
 
+// The best-model rule of M/best.safetensors: `a` beats `b` when its mean PSNR is not
+// lower and its mean LPIPS lower, or its PSNR higher and its LPIPS not higher (SSIM in
+// place of LPIPS without LPIPS weights). No weighting of one figure against another.
+bool ValidationBeats(const ValidationResult& a, const ValidationResult& b) {
+  const bool lpips = a.has_lpips && b.has_lpips;
+  const double qa = lpips ? a.lpips : -a.ssim, qb = lpips ? b.lpips : -b.ssim;
+  return (a.psnr >= b.psnr && qa < qb) || (a.psnr > b.psnr && qa <= qb);
+}
+
+// The validation figures of an earlier M/best.json (resume), if any.
+bool ReadBestValidation(const std::string& folder, ValidationResult* best) {
+  const std::string card = folder + "/best.json";
+  if (!std::filesystem::is_regular_file(card)) return false;
+  try {
+    const nlohmann::json v =
+        nlohmann::json::parse(ReadFileToString(card)).at("validation");
+    best->step = v.at("step").get<int>();
+    best->psnr = v.at("psnr").get<double>();
+    best->ssim = v.at("ssim").get<double>();
+    best->has_lpips = v.contains("lpips");
+    if (best->has_lpips) best->lpips = v.at("lpips").get<double>();
+    return true;
+  } catch (const std::exception&) {
+    return false;  // unreadable: the next validation writes a new one
+  }
+}
+
 }  // namespace
 
 Trainer::Trainer(const TrainOptions& options) : options_(options) {
@@ -201,9 +228,15 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
   } else {
     ConfigureTorchThreads();
   }
-  config_ = options_.model_config_json.empty()
-                ? ModelConfig::ForVariant(options_.variant)
-                : ModelConfig::FromJson(options_.model_config_json);
+  FvsNet init{nullptr};
+  if (!options_.init_weights.empty()) {
+    // Fine-tuning: the file's own layout, whatever --Train.variant says.
+    init = LoadModel(options_.init_weights, &config_);
+  } else {
+    config_ = options_.model_config_json.empty()
+                  ? ModelConfig::ForVariant(options_.variant)
+                  : ModelConfig::FromJson(options_.model_config_json);
+  }
   config_.Check();
   if (options_.device == "cuda") {
     Require(torch::cuda::is_available(), "view_synthesis_train",
@@ -224,7 +257,7 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
   }
 
   torch::manual_seed(static_cast<uint64_t>(options_.seed));
-  net_ = FvsNet(config_);
+  net_ = init.is_empty() ? FvsNet(config_) : init;
   net_->to(device_);
   optimizer_ = std::make_unique<torch::optim::Adam>(
       net_->parameters(), torch::optim::AdamOptions(options_.learning_rate));
@@ -247,6 +280,7 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
   loss.lpips_weight = options_.lpips_weight;
   loss_ = std::make_unique<TrainingLoss>(loss, device_);
   Resume();
+  has_best_ = ReadBestValidation(options_.output_path, &best_validation_);
 }
 
 void Trainer::LoadLpipsWeights() {
@@ -363,6 +397,15 @@ ValidationResult Trainer::Validate() {
   if (!options_.quiet) PrintValidation(step_, total_views, result);
   last_validation_ = result;
   has_validation_ = true;
+  if (total_views > 0 && (!has_best_ || ValidationBeats(result, best_validation_))) {
+    best_validation_ = result;
+    has_best_ = true;
+    SaveModel("best");
+    if (!options_.quiet) {
+      std::cerr << "[train] best so far: " << options_.output_path
+                << "/best.safetensors (step " << step_ << ")\n";
+    }
+  }
   return result;
 }
 
@@ -377,12 +420,13 @@ std::string Trainer::HardwareDescription() const {
   return s.str();
 }
 
-std::string Trainer::SaveModel() {
+std::string Trainer::SaveModel(const std::string& stem) {
   std::filesystem::create_directories(options_.output_path);
-  const std::string path = options_.output_path + "/model.safetensors";
+  const std::string path = options_.output_path + "/" + stem + ".safetensors";
   SaveWeights(net_, config_, path, options_.fp16_weights);
   nlohmann::json card;
-  card["weights"] = "model.safetensors";
+  card["weights"] = stem + ".safetensors";
+  if (!options_.init_weights.empty()) card["init_weights"] = options_.init_weights;
   card["variant"] = config_.variant;
   card["config"] = nlohmann::json::parse(config_.ToJson());
   card["loss"] = loss_->Name();
@@ -403,6 +447,8 @@ std::string Trainer::SaveModel() {
                      std::to_string(TORCH_VERSION_PATCH);
   card["written"] = UtcNow();
   card["final_loss"] = last_loss_;
+  if (options_.max_train_minutes > 0)
+    card["max_train_minutes"] = options_.max_train_minutes;
   auto scene_list = [](const std::vector<PackedScene>& scenes) {
     nlohmann::json list = nlohmann::json::array();
     for (const auto& s : scenes) {
@@ -426,7 +472,7 @@ std::string Trainer::SaveModel() {
     }
     card["validation"] = v;
   }
-  WriteFileAtomic(options_.output_path + "/model.json",
+  WriteFileAtomic(options_.output_path + "/" + stem + ".json",
                   [&](std::ostream& out) { out << card.dump(2) << "\n"; });
   return path;
 }
@@ -445,7 +491,11 @@ TrainSummary Trainer::Run() {
               << train_scenes_.size() << " scene(s), loss " << loss_->Name() << ", step "
               << step_ << " -> " << options_.max_steps << "\n";
   }
-  while (step_ < options_.max_steps) {
+  const double budget_seconds = options_.max_train_minutes * 60;
+  auto budget_spent = [&] {
+    return budget_seconds > 0 && train_seconds_ >= budget_seconds;
+  };
+  while (step_ < options_.max_steps && !budget_spent()) {
     Timer step_timer;
     const LossValue loss = Step();
     train_seconds_ += step_timer.Seconds();
@@ -453,9 +503,11 @@ TrainSummary Trainer::Run() {
     window_l1 += loss.l1;
     window_second += loss.second;
     ++window_steps;
-    if (step_ % options_.log_every == 0 || step_ == options_.max_steps) {
+    if (step_ % options_.log_every == 0 || step_ == options_.max_steps ||
+        budget_spent()) {
       const double rate = window_steps * options_.batch_size / window.Seconds();
-      const double eta = (options_.max_steps - step_) * options_.batch_size / rate;
+      double eta = (options_.max_steps - step_) * options_.batch_size / rate;
+      if (budget_seconds > 0) eta = std::min(eta, budget_seconds - train_seconds_);
       summary.final_loss = window_loss / window_steps;
       if (!options_.quiet) {
         std::cerr << "[train] step " << step_ << "/" << options_.max_steps << "  loss "

@@ -6,6 +6,8 @@
 //   M/validation.csv         step, scene, views, PSNR, SSIM, seconds per view, the same
 //                            of the ulr baseline, LPIPS of both (n/a without weights)
 //   M/model.safetensors      final weights (SaveWeights) and M/model.json, its card
+//   M/best.safetensors       the weights of the best validation so far and best.json
+//                            (rule: ValidationBeats in trainer.cc; kept across resumes)
 #pragma once
 
 #include <torch/torch.h>
@@ -52,12 +54,15 @@ class Trainer {
   ValidationResult Validate();
   // M/checkpoint-<step>.pt, atomically; removes all but the newest keep_checkpoints.
   std::string SaveCheckpoint();
-  // Weights and card at M/model.safetensors, M/model.json.
-  std::string SaveModel();
+  // Weights and card at M/<stem>.safetensors, M/<stem>.json.
+  std::string SaveModel(const std::string& stem = "model");
   // The whole loop to max_steps with progress, checkpoints, validation; stops cleanly on
   // SIGINT / SIGTERM after writing a checkpoint.
   TrainSummary Run();
 
+  // Replaces --Train.max_train_minutes (fine-tuning sets it once its setup is timed).
+  void SetMaxTrainSeconds(double seconds) { options_.max_train_minutes = seconds / 60; }
+  double train_seconds() const { return train_seconds_; }  // all invocations
   int step() const { return step_; }
   int resumed_from() const { return resumed_from_; }
   FvsNet& net() { return net_; }
@@ -91,6 +96,8 @@ class Trainer {
   double last_loss_ = 0;
   ValidationResult last_validation_;
   bool has_validation_ = false;
+  ValidationResult best_validation_;  // of M/best.safetensors
+  bool has_best_ = false;
 };
 
 }  // namespace fvs
