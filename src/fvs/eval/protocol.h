@@ -40,7 +40,7 @@ struct EvalTarget {
   std::string name;   // image name as in the model (or as asked, when missing)
   int position = -1;  // in the name-sorted list; -1 when not in the model
   bool geometry_holdout = false;  // listed in W/fvs/holdout.txt: unseen by the mesh
-  std::string error;  // non-empty: cannot be evaluated (not in the model, ...)
+  std::string error;     // non-empty: cannot be evaluated (not in the model, ...)
   bool skipped = false;  // not evaluated for the reason in `error`, not a failure
 };
 
