@@ -50,6 +50,44 @@ TEST(Protocol, AutoPicksHoldoutWhenThereIsOne) {
   EXPECT_THROW(SelectTargets(Names(4), {}, o), Error);
 }
 
+// A held-out image SfM did not register (prepare warned) is a skipped target with the
+// reason: not a failure, not counted in the summary, "skipped" in results.csv.
+TEST(Protocol, UnregisteredHoldoutIsSkippedWithTheReason) {
+  const TargetSet set = SelectTargets(Names(4), {"img_12.png", "lost.png"}, {});
+  ASSERT_EQ(TargetNames(set), (std::vector<std::string>{"img_12.png", "lost.png"}));
+  EXPECT_FALSE(set.targets[0].skipped);
+  EXPECT_TRUE(set.targets[0].error.empty());
+  EXPECT_TRUE(set.targets[1].skipped);
+  EXPECT_NE(set.targets[1].error.find("not registered by SfM"), std::string::npos);
+
+  ViewResult skipped;
+  skipped.target = "lost.png";
+  skipped.skipped = true;
+  skipped.error = set.targets[1].error;
+  ViewResult ok = skipped;
+  ok.target = "img_12.png";
+  ok.skipped = false;
+  ok.error.clear();
+  ok.psnr = 20;
+  ok.ssim = 0.5;
+  ok.seconds = 1;
+  EXPECT_FALSE(skipped.ok());
+  EXPECT_FALSE(skipped.failed());
+  const std::vector<ConfigSummary> summary = Summarize({ok, skipped});
+  ASSERT_EQ(summary.size(), 1u);
+  EXPECT_EQ(summary[0].views_ok, 1);
+  EXPECT_EQ(summary[0].views_failed, 0);
+  testing::TempDir dir;
+  WriteResultsCsv(dir / "results.csv", {ok, skipped});
+  EXPECT_NE(testing::ReadTextFile(dir / "results.csv").find(",skipped,"),
+            std::string::npos);
+  const std::vector<ViewResult> back = ReadResultsCsv(dir / "results.csv");
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_TRUE(back[1].skipped);
+  EXPECT_EQ(back[1].error, skipped.error);
+  EXPECT_FALSE(back[0].skipped);
+}
+
 TEST(Protocol, SubsequenceIsWithheldAsAWhole) {
   ProtocolOptions o;
   o.protocol = "subsequence";

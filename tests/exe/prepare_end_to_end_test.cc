@@ -1,15 +1,20 @@
 // view_synthesis_prepare from photos, as a user runs it: through the front door, killed
 // with SIGKILL part-way, then run again. The rerun must finish the job without redoing a
-// stage that had completed, and a third run must skip everything.
+// stage that had completed, a third run must skip everything, and so must a run on the
+// workspace moved elsewhere. A held-out photo that SfM cannot register is a warning, and
+// the evaluation lists it as skipped.
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
 #include <string>
 
+#include "colmap_ext/image_io.h"
 #include "colmap_ext/sparse_io.h"
 #include "fvs/geometry/ply.h"
+#include "fvs/util/hash.h"
 #include "support/test_support.h"
 
 namespace fvs::testing {
@@ -23,6 +28,19 @@ std::set<std::string> StagesMatching(const std::string& log, const std::string& 
     stages.insert((*it)[1]);
   }
   return stages;
+}
+
+// Content hash and modification time of each of `files` (relative to `root`).
+std::string Fingerprint(const std::string& root, const std::vector<std::string>& files) {
+  std::string out;
+  for (const std::string& f : files) {
+    const std::string path = root + "/" + f;
+    out += f + " " + HexHash(HashFile(path)) + " " +
+           std::to_string(
+               std::filesystem::last_write_time(path).time_since_epoch().count()) +
+           "\n";
+  }
+  return out;
 }
 
 TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
@@ -71,6 +89,84 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
   EXPECT_GT(mesh.faces.size(), 1000u);
   EXPECT_TRUE(std::filesystem::exists(dir / "ws/fvs/depth/frame_0000.png.bin"));
   EXPECT_FALSE(std::filesystem::exists(dir / "ws/fvs/tmp"));
+
+  // The workspace moved elsewhere: every stage is still up to date, and nothing changes.
+  const std::vector<std::string> outputs = {
+      "database.db",     "sfm/0/images.bin",     "sparse/images.bin",
+      "fused.ply",       "meshed-delaunay.ply",  "fvs/depth/frame_0000.png.bin",
+      "fvs/holdout.txt", "fvs/registration.json"};
+  const std::string before = Fingerprint(dir / "ws", outputs);
+  std::filesystem::create_directories(dir / "elsewhere");
+  ASSERT_EQ(RunShell("mv " + dir / "ws" + " " + dir / "elsewhere/moved"), 0);
+  const std::string moved = colmap + " view_synthesis_prepare --image_path " +
+                            dir / "scene/images" + " --workspace_path " +
+                            dir / "elsewhere/moved" + " --holdout_images frame_0009.png";
+  std::string moved_log;
+  ASSERT_EQ(RunShell(moved, &moved_log), 0) << moved_log;
+  EXPECT_EQ(StagesMatching(moved_log, "up to date").size(), 8u) << moved_log;
+  EXPECT_TRUE(StagesMatching(moved_log, "done in").empty()) << moved_log;
+  EXPECT_EQ(Fingerprint(dir / "elsewhere/moved", outputs), before);
+  EXPECT_EQ(ReadTextFile(dir / "elsewhere/moved/fvs/manifest.json").find(dir.path()),
+            std::string::npos)
+      << "the manifest holds absolute paths";
+}
+
+// A held-out photo that SfM does not register (a featureless gradient among the
+// generated views) is a warning: prepare finishes, reports 10 of 11 registered, and the
+// evaluation evaluates the other held-out view and lists this one as skipped.
+TEST(PrepareEndToEnd, UnregisteredHoldoutIsAWarningAndEvaluationSkipsIt) {
+  TempDir dir;
+  const std::string colmap =
+      "QT_QPA_PLATFORM=offscreen FVS_QUIET=1 '" + FrontDoorBinary() + "'";
+  std::string log;
+  ASSERT_EQ(RunShell(colmap + " view_synthesis_synthetic --output_path " + dir / "scene" +
+                         " --SyntheticScene.num_views 10 --SyntheticScene.width 320"
+                         " --SyntheticScene.height 240",
+                     &log),
+            0)
+      << log;
+  Image gradient(320, 240, 3);
+  for (int y = 0; y < 240; ++y) {
+    for (int x = 0; x < 320; ++x) {
+      for (int c = 0; c < 3; ++c) gradient.at(x, y, c) = 0.2f + 0.5f * x / 320.0f;
+    }
+  }
+  colmap::WriteImage(dir / "scene/images/zz_blank.png", gradient);
+  ASSERT_EQ(RunShell(colmap + " view_synthesis_prepare --image_path " +
+                         dir / "scene/images" + " --workspace_path " + dir / "ws" +
+                         " --holdout_images frame_0008.png,zz_blank.png 2>&1",
+                     &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("WARNING: holdout image 'zz_blank.png' was not registered by SfM"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("registered 10 of 11 images"), std::string::npos) << log;
+  const auto report =
+      nlohmann::json::parse(ReadTextFile(dir / "ws/fvs/registration.json"));
+  EXPECT_EQ(report["images"].get<int>(), 11);
+  EXPECT_EQ(report["registered"].get<int>(), 10);
+  EXPECT_EQ(report["unregistered"], nlohmann::json::array({"zz_blank.png"}));
+  EXPECT_EQ(report["matcher"].get<std::string>(), "exhaustive");
+  EXPECT_TRUE(std::filesystem::exists(dir / "ws/meshed-delaunay.ply"));
+
+  ASSERT_EQ(RunShell(colmap + " view_synthesis_eval --workspace_path " + dir / "ws" +
+                         " --output_path " + dir / "eval" + " 2>&1",
+                     &log),
+            0)
+      << log;
+  const std::string csv = ReadTextFile(dir / "eval/results.csv");
+  const size_t blank = csv.find(",zz_blank.png,");
+  ASSERT_NE(blank, std::string::npos) << csv;
+  const std::string row = csv.substr(blank, csv.find('\n', blank) - blank);
+  EXPECT_NE(row.find(",skipped,"), std::string::npos) << row;
+  EXPECT_NE(row.find("not registered by SfM"), std::string::npos) << row;
+  const size_t held = csv.find(",frame_0008.png,");
+  ASSERT_NE(held, std::string::npos) << csv;
+  EXPECT_NE(csv.substr(held, csv.find('\n', held) - held).find(",ok,"), std::string::npos)
+      << csv;
+  EXPECT_NE(ReadTextFile(dir / "eval/results.md").find("not registered by SfM"),
+            std::string::npos);
 }
 
 TEST(PrepareEndToEnd, BadInputIsOneLine) {

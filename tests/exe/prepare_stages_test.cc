@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <set>
 
 #include "colmap_ext/reconstruction.h"
 #include "colmap_ext/sparse_io.h"
@@ -28,6 +29,70 @@ TEST(PrepareStages, RecognisesVideoFrames) {
   std::vector<std::string> mixed = frames;
   mixed[3] = "castle.jpg";
   EXPECT_FALSE(LooksLikeVideoFrames(mixed));
+}
+
+std::vector<std::string> NumberedNames(int n, const char* format) {
+  std::vector<std::string> names;
+  for (int i = 0; i < n; ++i) {
+    char name[64];
+    std::snprintf(name, sizeof(name), format, i);
+    names.push_back(name);
+  }
+  return names;
+}
+
+// Name order is no evidence of a video: up to the affordable size every pair is matched,
+// numbered or not; only long runs of consecutive frames get sequential matching.
+TEST(PrepareStages, AutoMatchingIsExhaustiveWhileAffordable) {
+  // The set that lost 7 of 25 photos to sequential matching.
+  EXPECT_EQ(ChooseMatcher(NumberedNames(25, "%02d.jpg"), false).type, "exhaustive");
+  EXPECT_EQ(ChooseMatcher(NumberedNames(150, "frame_%05d.png"), false).type,
+            "exhaustive");
+  EXPECT_EQ(
+      ChooseMatcher(NumberedNames(kMaxExhaustiveImages, "frame_%05d.png"), false).type,
+      "exhaustive");
+  const MatcherChoice video =
+      ChooseMatcher(NumberedNames(kMaxExhaustiveImages + 1, "frame_%05d.png"), false);
+  EXPECT_EQ(video.type, "sequential");
+  EXPECT_NE(video.reason.find("loop closure"), std::string::npos) << video.reason;
+  // With matching on a GPU, exhaustive goes further.
+  EXPECT_EQ(ChooseMatcher(NumberedNames(600, "frame_%05d.png"), true).type, "exhaustive");
+  EXPECT_EQ(ChooseMatcher(NumberedNames(1200, "frame_%05d.png"), true).type,
+            "sequential");
+  // Many unordered photos: still every pair (nothing cheaper registers them).
+  std::vector<std::string> unordered;
+  for (int i = 0; i < 300; ++i)
+    unordered.push_back("IMG_" + std::to_string(1000 + 7 * i) + ".JPG");
+  const MatcherChoice photos = ChooseMatcher(unordered, false);
+  EXPECT_EQ(photos.type, "exhaustive");
+  EXPECT_NE(photos.reason.find("44850 pairs"), std::string::npos) << photos.reason;
+}
+
+TEST(PrepareStages, SequentialPairsCloseLoops) {
+  const int n = 400;
+  const std::vector<std::pair<int, int>> pairs = SequentialPairs(n);
+  const std::set<std::pair<int, int>> set(pairs.begin(), pairs.end());
+  EXPECT_EQ(set.size(), pairs.size());
+  for (const auto& [i, j] : pairs) {
+    EXPECT_LT(i, j);
+    EXPECT_LT(j, n);
+  }
+  EXPECT_TRUE(set.count({10, 20}));  // the next 10
+  EXPECT_FALSE(set.count({10, 21}));
+  EXPECT_TRUE(set.count({10, 10 + 256}));  // quadratic overlap
+  // Loop closure: the first and the last frame, and keyframes far apart.
+  EXPECT_TRUE(set.count({0, n - 1}));
+  EXPECT_TRUE(set.count({8, 392}));
+  // Far fewer than every pair.
+  EXPECT_LT(pairs.size(), static_cast<size_t>(n) * (n - 1) / 2 / 5);
+  EXPECT_TRUE(SequentialPairs(1).empty());
+  EXPECT_EQ(SequentialPairs(2), (std::vector<std::pair<int, int>>{{0, 1}}));
+}
+
+TEST(PrepareStages, RetriesExhaustiveOnlyWhenPhotosWereLost) {
+  EXPECT_TRUE(ShouldRetryExhaustive("sequential", 18, 25));
+  EXPECT_FALSE(ShouldRetryExhaustive("sequential", 25, 25));
+  EXPECT_FALSE(ShouldRetryExhaustive("exhaustive", 18, 25));  // nothing more thorough
 }
 
 TEST(PrepareStages, WarnsWhenUndistortionShrinksTheImages) {

@@ -44,7 +44,7 @@ Image MakeContactSheet(const std::string& title, const std::vector<ViewResult>& 
             ? r.target + "  PSNR " + FormatNumber(r.psnr, 2) + "  SSIM " +
                   FormatNumber(r.ssim, 3) + "  LPIPS " + FormatNumber(r.lpips, 3) + "  " +
                   FormatNumber(r.seconds, 2) + " s  K " + std::to_string(r.sources_used)
-            : r.target + "  ERROR: " + r.error;
+            : r.target + (r.skipped ? "  SKIPPED: " : "  ERROR: ") + r.error;
     DrawText(&sheet, kPad, y, label, r.ok() ? kInk : kError);
     y += kLine;
     if (const ViewThumbnails* t = find_thumbnail(r.target)) {

@@ -127,6 +127,7 @@ std::vector<ViewResult> EvaluateTargets(
     r.target = target.name;
     r.geometry_holdout = target.geometry_holdout;
     r.error = target.error;
+    r.skipped = target.skipped;
     const int index = r.ok() ? scene.FindView(target.name) : -1;
     if (r.ok() && index < 0) r.error = "not a registered image of the model";
     if (r.ok()) {
@@ -190,8 +191,8 @@ std::vector<ViewResult> EvaluateTargets(
       }
     }
     if (!r.ok()) {
-      std::fprintf(stderr, "WARNING: %s [%s]: %s\n", r.target.c_str(),
-                   config.Label().c_str(), r.error.c_str());
+      std::fprintf(stderr, "WARNING: %s [%s]: %s%s\n", r.target.c_str(),
+                   config.Label().c_str(), r.skipped ? "skipped: " : "", r.error.c_str());
     }
     results.push_back(std::move(r));
     if (progress) progress->Advance();

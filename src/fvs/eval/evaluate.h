@@ -49,7 +49,8 @@ struct ViewResult {
   std::string protocol;
   std::string target;
   bool geometry_holdout = false;
-  std::string error;  // empty: evaluated
+  std::string error;     // empty: evaluated
+  bool skipped = false;  // not evaluated for the reason in `error`, not a failure
   double psnr = kNotAvailable;
   double ssim = kNotAvailable;
   double lpips = kNotAvailable;  // NaN: not available (no weights), never a guess
@@ -74,6 +75,7 @@ struct ViewResult {
   int width = 0, height = 0;  // the photo's size (metrics are computed at it)
 
   bool ok() const { return error.empty(); }
+  bool failed() const { return !ok() && !skipped; }
 };
 
 // Thumbnails for the contact sheet (rendered beside the photo).

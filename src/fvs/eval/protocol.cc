@@ -103,7 +103,15 @@ TargetSet SelectTargets(const std::vector<std::string>& unsorted_names,
         !holdout.empty(), kWho,
         "--protocol holdout: the workspace has no held-out images (W/fvs/holdout.txt; "
         "prepare with --holdout_images)");
-    for (const std::string& name : holdout) add_name(name);
+    for (const std::string& name : holdout) {
+      add_name(name);
+      if (set.targets.back().position < 0) {
+        set.targets.back().skipped = true;
+        set.targets.back().error =
+            "held out but not registered by SfM: no pose to render "
+            "(W/fvs/registration.json)";
+      }
+    }
   } else if (set.protocol == "leave_one_out") {
     for (int i = 0; i < static_cast<int>(names.size()); i += options.every) {
       add_name(names[i]);

@@ -13,6 +13,8 @@
 //                  none of them is a source.
 // A name or position not in the model is kept as a target with an error, so that the
 // report says what was asked and why it has no numbers, while the others are evaluated.
+// A held-out image SfM did not register (prepare warned) is kept as a skipped target:
+// it has no pose to render, which is the photos' fault, not the evaluation's.
 #pragma once
 
 #include <set>
@@ -38,7 +40,8 @@ struct EvalTarget {
   std::string name;   // image name as in the model (or as asked, when missing)
   int position = -1;  // in the name-sorted list; -1 when not in the model
   bool geometry_holdout = false;  // listed in W/fvs/holdout.txt: unseen by the mesh
-  std::string error;  // non-empty: cannot be evaluated (not in the model, ...)
+  std::string error;     // non-empty: cannot be evaluated (not in the model, ...)
+  bool skipped = false;  // not evaluated for the reason in `error`, not a failure
 };
 
 struct TargetSet {

@@ -130,7 +130,7 @@ std::vector<ConfigSummary> Summarize(const std::vector<ViewResult>& results,
     ConfigSummary& s = summary[it->second];
     Sums& t = sums[it->second];
     if (!r.ok()) {
-      ++s.views_failed;
+      s.views_failed += r.failed();
       continue;
     }
     ++s.views_ok;
@@ -183,7 +183,10 @@ void WriteResultsCsv(const std::string& path, const std::vector<ViewResult>& res
       out << CsvField(r.scene) << "," << CsvField(r.config.method) << ","
           << r.config.num_sources << "," << scale << "," << CsvField(r.config.precision)
           << "," << CsvField(r.protocol) << "," << CsvField(r.target) << ","
-          << (r.geometry_holdout ? "yes" : "no") << "," << (r.ok() ? "ok" : "error")
+          << (r.geometry_holdout ? "yes" : "no") << ","
+          << (r.ok()      ? "ok"
+              : r.skipped ? "skipped"
+                          : "error")
           << "," << FormatNumber(r.psnr, 4) << "," << FormatNumber(r.ssim, 5) << ","
           << FormatNumber(r.lpips, 5) << "," << FormatNumber(r.psnr_covered, 4) << ","
           << FormatNumber(r.ssim_covered, 5) << "," << FormatNumber(r.seconds, 4) << ","
@@ -225,7 +228,9 @@ std::vector<ViewResult> ReadResultsCsv(const std::string& path) {
     r.target = fields[6];
     r.geometry_holdout = fields[7] == "yes";
     const bool ok = fields[8] == "ok";
-    Require(ok || fields[8] == "error", where, "status must be ok or error");
+    r.skipped = fields[8] == "skipped";
+    Require(ok || r.skipped || fields[8] == "error", where,
+            "status must be ok, skipped or error");
     r.psnr = ParseNumber(fields[9], where);
     r.ssim = ParseNumber(fields[10], where);
     r.lpips = ParseNumber(fields[11], where);
@@ -246,7 +251,7 @@ std::vector<ViewResult> ReadResultsCsv(const std::string& path) {
       Require(std::isfinite(r.psnr) && std::isfinite(r.ssim) && std::isfinite(r.seconds),
               where, "status ok without psnr, ssim and seconds");
     } else if (r.error.empty()) {
-      r.error = "error (no message)";
+      r.error = r.skipped ? "skipped (no reason)" : "error (no message)";
     }
     results.push_back(std::move(r));
   }
@@ -317,7 +322,7 @@ void WriteMarkdownReport(const std::string& path, const ReportContext& context,
           << FormatNumber(r.ssim_covered, 4) << " | " << FormatNumber(r.seconds, 3)
           << " | " << FormatNumber(r.cpu_seconds, 3) << " | " << r.sources_used << " | "
           << FormatNumber(100 * r.coverage, 1) << (r.ok() ? "%" : "") << " | "
-          << cell(r.error) << " |\n";
+          << (r.skipped ? "skipped: " : "") << cell(r.error) << " |\n";
     }
   });
 }

@@ -7,6 +7,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "colmap_ext/reconstruction.h"
@@ -92,7 +93,7 @@ struct StageRunner {
            const std::function<void()>& run) {
     ++index;
     const std::string fingerprint =
-        Digest(previous + "\n" + Manifest::Fingerprint(inputs, options));
+        Digest(previous + "\n" + Manifest::Fingerprint(inputs, options, manifest.root()));
     previous = fingerprint;
     if (manifest.IsUpToDate(name, fingerprint, outputs)) {
       std::cerr << "[" << index << "/" << total << "] " << name
@@ -117,6 +118,107 @@ bool IsImageExtension(std::string ext) {
                  [](unsigned char c) { return std::tolower(c); });
   return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".tif" ||
          ext == ".tiff" || ext == ".bmp" || ext == ".ppm" || ext == ".pgm";
+}
+
+// Matches the images of `database` with `type` (exhaustive, or sequential with loop
+// closure: SequentialPairs through COLMAP's matches_importer). Pairs already matched in
+// the database are not matched again.
+void RunMatcher(const std::string& type, const std::string& database,
+                const std::vector<std::string>& images, const std::string& pairs_path,
+                const std::string& gpu, const std::string& threads) {
+  const std::vector<std::string> sift = {"--SiftMatching.use_gpu", gpu,
+                                         "--SiftMatching.num_threads", threads};
+  std::vector<std::string> args;
+  const bool spaces = std::any_of(images.begin(), images.end(), [](const std::string& n) {
+    return n.find(' ') != std::string::npos;
+  });
+  if (type == "exhaustive") {
+    args = {"exhaustive_matcher", "--database_path", database};
+  } else if (spaces) {
+    // COLMAP's pair lists split at spaces: its own sequential matcher, no loop closure.
+    std::cerr << "  image names with spaces: COLMAP's sequential matcher, without loop "
+                 "closure\n";
+    args = {"sequential_matcher", "--database_path", database};
+  } else {
+    WriteFileAtomic(pairs_path, [&](std::ostream& out) {
+      for (const auto& [i, j] : SequentialPairs(static_cast<int>(images.size()))) {
+        out << images[i] << " " << images[j] << "\n";
+      }
+    });
+    args = {"matches_importer", "--database_path", database, "--match_list_path",
+            pairs_path,         "--match_type",    "pairs"};
+  }
+  args.insert(args.end(), sift.begin(), sift.end());
+  colmap::RunColmap(args);
+}
+
+struct MappedModel {
+  std::string path;  // the largest model COLMAP's mapper made
+  int registered = 0;
+};
+
+// Runs COLMAP's mapper into `out` and picks the model with most registered images
+// (COLMAP numbers models by discovery, not size).
+MappedModel MapLargestModel(const PrepareContext& c, const std::string& database,
+                            const std::string& out, const std::string& threads) {
+  colmap::CreateDirectories(out);
+  colmap::RunColmap({"mapper", "--database_path", database, "--image_path", c.image_path,
+                     "--output_path", out, "--Mapper.num_threads", threads});
+  MappedModel best;
+  for (const auto& entry : fs::directory_iterator(out)) {
+    if (!entry.is_directory()) continue;
+    const colmap::Reconstruction rec = colmap::ReadSparseModel(entry.path().string());
+    if (static_cast<int>(rec.images.size()) > best.registered) {
+      best.registered = static_cast<int>(rec.images.size());
+      best.path = entry.path().string();
+    }
+  }
+  return best;
+}
+
+// W/fvs/registration.json: how many of the photos SfM registered, which not, and how
+// they were matched.
+void WriteRegistrationReport(const std::string& path,
+                             const std::vector<std::string>& images,
+                             const std::string& model_path, const std::string& matcher,
+                             bool retried) {
+  const colmap::Reconstruction rec = colmap::ReadSparseModel(model_path);
+  std::set<std::string> registered;
+  for (const auto& [id, image] : rec.images) registered.insert(image.name);
+  nlohmann::json j;
+  j["images"] = images.size();
+  j["registered"] = registered.size();
+  j["matcher"] = matcher;
+  j["retried_exhaustive"] = retried;
+  j["unregistered"] = nlohmann::json::array();
+  for (const std::string& name : images) {
+    if (!registered.count(name)) j["unregistered"].push_back(name);
+  }
+  WriteFileAtomic(path, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+}
+
+// Registered of total photos, and a warning for each held-out photo SfM did not
+// register: it has no pose, so it cannot be a target (view_synthesis_eval skips it).
+void ReportRegistration(const std::string& path, const std::set<std::string>& holdout) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(ReadFileToString(path));
+    j.at("registered").get<int>();
+    j.at("images").get<int>();
+    j.at("unregistered").get<std::vector<std::string>>();
+  } catch (const std::exception& e) {
+    std::cerr << "WARNING: " << path << ": unreadable (" << e.what() << ")\n";
+    return;
+  }
+  std::cerr << "SfM registered " << j.at("registered").get<int>() << " of "
+            << j.at("images").get<int>() << " images (" << path << ")\n";
+  for (const auto& name : j.at("unregistered")) {
+    if (holdout.count(name.get<std::string>())) {
+      std::cerr << "WARNING: holdout image '" << name.get<std::string>()
+                << "' was not registered by SfM: it has no pose, so view_synthesis_eval "
+                   "will skip it\n";
+    }
+  }
 }
 
 }  // namespace
@@ -176,6 +278,50 @@ bool LooksLikeVideoFrames(const std::vector<std::string>& names) {
     last = n;
   }
   return consecutive >= static_cast<int>(names.size() * 9 / 10);
+}
+
+MatcherChoice ChooseMatcher(const std::vector<std::string>& names, bool gpu) {
+  const size_t n = names.size();
+  const size_t limit = gpu ? kMaxExhaustiveImagesGpu : kMaxExhaustiveImages;
+  const std::string count = std::to_string(n) + " images";
+  if (n <= limit) {
+    return {"exhaustive",
+            count + ", at most " + std::to_string(limit) + ": every pair is matched"};
+  }
+  if (LooksLikeVideoFrames(names)) {
+    return {"sequential", count + " numbered as consecutive video frames, over " +
+                              std::to_string(limit) + ": sequential with loop closure"};
+  }
+  return {"exhaustive",
+          count + " over " + std::to_string(limit) +
+              ", not consecutive frames: every pair is matched (" +
+              std::to_string(n * (n - 1) / 2) +
+              " pairs; --Matching.type sequential is far cheaper for video frames)"};
+}
+
+std::vector<std::pair<int, int>> SequentialPairs(int n, int overlap) {
+  std::set<std::pair<int, int>> pairs;
+  if (n < 2) return {};
+  for (int i = 0; i < n; ++i) {
+    for (int k = 1; k <= overlap && i + k < n; ++k) pairs.insert({i, i + k});
+    int step = 1;
+    for (int k = 0; k < overlap && i + step < n; ++k, step *= 2)
+      pairs.insert({i, i + step});
+  }
+  const int every = std::max(5, (n + 49) / 50);
+  std::vector<int> keyframes;
+  for (int i = 0; i < n; i += every) keyframes.push_back(i);
+  if (keyframes.back() != n - 1) keyframes.push_back(n - 1);
+  for (size_t a = 0; a < keyframes.size(); ++a) {
+    for (size_t b = a + 1; b < keyframes.size(); ++b) {
+      pairs.insert({keyframes[a], keyframes[b]});
+    }
+  }
+  return {pairs.begin(), pairs.end()};
+}
+
+bool ShouldRetryExhaustive(const std::string& matcher, int registered, int total) {
+  return matcher != "exhaustive" && registered < total;
 }
 
 void WriteStereoConfigs(const std::string& workspace_path,
@@ -264,10 +410,11 @@ void RunPrepareStages(const PrepareContext& c) {
   const std::string sfm_model = c.workspace_path + "/sfm/0";
 
   std::string matcher = c.matcher;
+  std::string matcher_reason = "--Matching.type " + matcher;
   if (matcher == "auto") {
-    matcher = LooksLikeVideoFrames(images) ? "sequential"
-              : images.size() > 150        ? "sequential"
-                                           : "exhaustive";
+    const MatcherChoice choice = ChooseMatcher(images, colmap_caps.has_cuda);
+    matcher = choice.type;
+    matcher_reason = choice.reason;
   }
   const bool builtin_stereo = c.stereo_backend == "builtin" ||
                               (c.stereo_backend == "auto" && !colmap_caps.has_cuda);
@@ -285,7 +432,7 @@ void RunPrepareStages(const PrepareContext& c) {
   for (const std::string& h : c.holdout) holdout_list += h + ",";
 
   StageRunner stages;
-  stages.manifest = Manifest::Load(ws.ManifestPath());
+  stages.manifest = Manifest::Load(ws.ManifestPath(), c.workspace_path);
   stages.total = 8;
   const std::string gpu = colmap_caps.has_cuda ? "1" : "0";
 
@@ -305,44 +452,48 @@ void RunPrepareStages(const PrepareContext& c) {
         MoveIntoPlace(tmp_db, database);
       });
 
-  stages.Run("matching", {}, matcher, {database}, [&] {
-    // Matching writes into the database: work on a copy, so a kill leaves the extracted
-    // features untouched.
+  // Matching writes into the database: work on a copy, so a kill leaves what was there
+  // untouched.
+  auto match_into_database = [&](const std::string& type) {
     const std::string tmp_db = tmp_dir + "/database.db";
     fs::copy_file(database, tmp_db, fs::copy_options::overwrite_existing);
-    colmap::RunColmap({matcher + "_matcher", "--database_path", tmp_db,
-                       "--SiftMatching.use_gpu", gpu, "--SiftMatching.num_threads",
-                       threads});
+    RunMatcher(type, tmp_db, images, tmp_dir + "/pairs.txt", gpu, threads);
     MoveIntoPlace(tmp_db, database);
+  };
+  stages.Run("matching", {}, matcher, {database}, [&] {
+    std::cerr << "  " << matcher << " matching: " << matcher_reason << "\n";
+    match_into_database(matcher);
   });
 
+  const std::string registration_path = fvs_dir + "/registration.json";
   stages.Run("mapping", {}, "", {sfm_model}, [&] {
-    const std::string out = tmp_dir + "/sfm";
-    colmap::CreateDirectories(out);
-    colmap::RunColmap({"mapper", "--database_path", database, "--image_path",
-                       c.image_path, "--output_path", out, "--Mapper.num_threads",
-                       threads});
-    // The largest model is the scene (COLMAP numbers models by discovery, not size).
-    std::string best;
-    size_t best_images = 0;
-    for (const auto& entry : fs::directory_iterator(out)) {
-      if (!entry.is_directory()) continue;
-      const colmap::Reconstruction rec = colmap::ReadSparseModel(entry.path().string());
-      if (rec.images.size() > best_images) {
-        best_images = rec.images.size();
-        best = entry.path().string();
-      }
+    const int total = static_cast<int>(images.size());
+    MappedModel best = MapLargestModel(c, database, tmp_dir + "/sfm", threads);
+    const bool retry = ShouldRetryExhaustive(matcher, best.registered, total);
+    if (retry) {
+      std::cerr << "  registered " << best.registered << " of " << total
+                << " images after " << matcher
+                << " matching: matching every pair and mapping again\n";
+      match_into_database("exhaustive");
+      const MappedModel second =
+          MapLargestModel(c, database, tmp_dir + "/sfm_exhaustive", threads);
+      if (second.registered > best.registered) best = second;
     }
-    if (best.empty() || best_images < 3) {
-      throw Error(c.image_path, "SfM registered " + std::to_string(best_images) + " of " +
-                                    std::to_string(images.size()) +
+    if (best.path.empty() || best.registered < 3) {
+      throw Error(c.image_path, "SfM registered " + std::to_string(best.registered) +
+                                    " of " + std::to_string(total) +
                                     " images: too few for view synthesis (photos need "
                                     "more overlap and texture)");
     }
-    std::cerr << "  registered " << best_images << " of " << images.size() << " images\n";
+    std::cerr << "  registered " << best.registered << " of " << total << " images\n";
+    WriteRegistrationReport(registration_path, images, best.path, matcher, retry);
     colmap::CreateDirectories(c.workspace_path + "/sfm");
-    MoveIntoPlace(best, sfm_model);
+    MoveIntoPlace(best.path, sfm_model);
   });
+  // Workspaces prepared before the report existed.
+  if (!fs::exists(registration_path)) {
+    WriteRegistrationReport(registration_path, images, sfm_model, matcher, false);
+  }
 
   stages.Run("undistortion", {},
              "size=" + std::to_string(c.max_image_size) + " holdout=" + holdout_list,
@@ -358,12 +509,6 @@ void RunPrepareStages(const PrepareContext& c) {
                for (const std::string& w : ShrunkenUndistortionWarnings(
                         colmap::ReadSparseModel(sfm_model), rec, c.max_image_size)) {
                  std::cerr << "WARNING: " << w << "\n";
-               }
-               for (const std::string& h : c.holdout) {
-                 if (rec.FindImageByName(h) == nullptr) {
-                   throw Error(c.image_path,
-                               "holdout image '" + h + "' was not registered by SfM");
-                 }
                }
                colmap::CreateDirectories(ws.StereoDir());
                MoveIntoPlace(out + "/images", ws.ImagesDir());
@@ -428,6 +573,7 @@ void RunPrepareStages(const PrepareContext& c) {
     RunOurCommand("view_synthesis_depth_cache", {"--workspace_path", c.workspace_path});
   });
   RemoveAll(tmp_dir);
+  ReportRegistration(registration_path, c.holdout);
   std::cerr << "Scene ready: " << c.workspace_path << "\n";
 }
 

@@ -32,6 +32,35 @@ std::vector<std::string> ListImageFiles(const std::string& folder);
 // True when names look like frames of a video: a common prefix and consecutive numbers.
 bool LooksLikeVideoFrames(const std::vector<std::string>& names);
 
+// Up to this many photos --Matching.type auto matches every pair (exhaustive), whatever
+// the names: n (n - 1) / 2 pairs, 19,900 at 200. CPU SIFT matching took 0.1-0.9 s per
+// pair on the shared scenes here (2 cores), so 200 photos are about 0.5-5 core-hours,
+// comparable to CPU stereo on them; COLMAP's GPU matcher is some 50 times faster.
+constexpr int kMaxExhaustiveImages = 200;
+constexpr int kMaxExhaustiveImagesGpu = 1000;
+
+struct MatcherChoice {
+  std::string type;    // "exhaustive" or "sequential"
+  std::string reason;  // for the log
+};
+
+// The rule of --Matching.type auto: exhaustive up to kMaxExhaustiveImages photos
+// (kMaxExhaustiveImagesGpu when SIFT matches on a GPU), numbered or not (name order is
+// no evidence of a video); beyond that, sequential with loop closure for frames of a
+// video (LooksLikeVideoFrames), and still exhaustive for unordered photos (nothing
+// cheaper registers them without a vocabulary tree).
+MatcherChoice ChooseMatcher(const std::vector<std::string>& names, bool gpu);
+
+// The image pairs of sequential matching with loop closure, in name order: each frame
+// with the next `overlap` and with those 2^k after it (COLMAP's quadratic overlap), and
+// every pair of keyframes (every max(5, ceil(n / 50))-th frame, at most about 50 of
+// them), which closes loops where the camera comes back. Each pair once, i < j.
+std::vector<std::pair<int, int>> SequentialPairs(int num_images, int overlap = 10);
+
+// More thorough matching is worth one retry: mapping registered fewer photos than it
+// was given after a matcher that did not try every pair.
+bool ShouldRetryExhaustive(const std::string& matcher, int registered, int total);
+
 // Writes stereo/patch-match.cfg and stereo/fusion.cfg listing the non-holdout images,
 // each with explicit sources (the images sharing most sparse points, holdouts excluded),
 // so no evaluation target leaks into the geometry.

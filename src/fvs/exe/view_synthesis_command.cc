@@ -9,7 +9,10 @@
 // Renders every target into O/<name>.png (plus the optional extras, see render_output.h)
 // and prints a per-target timing summary (depth / selection / warp / blend). A target
 // whose PNG already exists (and has the right size) is skipped unless --overwrite 1, so
-// an interrupted render resumes at the first missing frame. O/frame_report.{csv,json}
+// an interrupted render resumes at the first missing frame. Frames are resumed only when
+// O/render_settings.json matches this run: the settings, and the content hashes of the
+// weights, of the workspace (sparse model, mesh, photos) and of the target file, so
+// weights retrained to the same path never reuse old frames. O/frame_report.{csv,json}
 // hold per frame the coverage (flagged under --flag_coverage), the sources, the flicker
 // to the previous frame (fvs/path/flicker.h) and the PSNR against the ground truth. The
 // temporal chain (stable sources, blend, flicker) goes on across resumed frames: the last
@@ -26,6 +29,7 @@
 #include <vector>
 
 #include "colmap_ext/image_io.h"
+#include "colmap_ext/workspace.h"
 #include "fvs/eval/metrics.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/option_manager.h"
@@ -38,8 +42,8 @@
 #include "fvs/scene/scene.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
+#include "fvs/util/hash.h"
 #include "fvs/util/machine.h"
-#include "fvs/util/manifest.h"
 #include "fvs/util/progress.h"
 #include "fvs/util/shard.h"
 #include "fvs/util/string_util.h"
@@ -99,12 +103,64 @@ double CameraPathFps(const std::string& path) {
   }
 }
 
-// What decides the pixels of a frame: a frame rendered with other settings is not
-// resumed.
+// The regular files below `folder` (or `folder` itself when a file), sorted; none when
+// it does not exist.
+std::vector<std::string> FilesBelow(const std::string& folder) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> files;
+  std::error_code ec;
+  if (fs::is_regular_file(folder, ec)) return {folder};
+  for (auto it = fs::recursive_directory_iterator(folder, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    if (it->is_regular_file()) files.push_back(it->path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// Content hash of `paths` (files, or folders: every file below them), names relative to
+// `root` included: the same bytes wherever they lie give the same hash.
+std::string ContentHash(const std::vector<std::string>& paths, const std::string& root) {
+  uint64_t hash = 0;
+  for (const std::string& path : paths) {
+    for (const std::string& file : FilesBelow(path)) {
+      const std::string name = std::filesystem::path(file).lexically_relative(root);
+      hash = HashFile(file, Hash64(name.data(), name.size(), hash));
+    }
+  }
+  return HexHash(hash);
+}
+
+// What the renderer takes from the workspace: the sparse model, the mesh and the
+// undistorted photos (the source depths follow from the first two).
+std::string WorkspaceHash(const std::string& workspace_path) {
+  const colmap::DenseWorkspace ws(workspace_path);
+  return ContentHash({ws.SparseDir(), ws.DelaunayMeshPath(), ws.ImagesDir()},
+                     workspace_path);
+}
+
+// The target file and, for images.txt, the cameras.txt beside it.
+std::string TargetsHash(const ViewSynthesisOptions& o) {
+  if (!o.camera_path.empty()) {
+    return ContentHash({o.camera_path},
+                       std::filesystem::path(o.camera_path).parent_path().string());
+  }
+  if (o.target_images.empty()) return "";
+  const std::filesystem::path folder =
+      std::filesystem::path(o.target_images).parent_path();
+  return ContentHash({o.target_images, (folder / "cameras.txt").string()},
+                     folder.string());
+}
+
+// What decides the pixels of a frame: a frame rendered with other settings, weights,
+// workspace or targets (compared by content, not by path or time) is not resumed.
 std::string RenderSettings(const ViewSynthesisOptions& o) {
   nlohmann::json json;
   json["method"] = o.method;
-  json["model_path"] = o.render.model_path;
+  if (!o.render.model_path.empty()) {
+    json["weights_hash"] = HexHash(HashFile(o.render.model_path));
+  }
+  json["workspace_hash"] = WorkspaceHash(o.workspace_path);
   json["num_sources"] = o.render.num_sources;
   json["selection_tolerance"] = o.render.selection_tolerance;
   json["warp_tolerance"] = o.render.warp_tolerance;
@@ -122,13 +178,12 @@ std::string RenderSettings(const ViewSynthesisOptions& o) {
     json["tile_size"] = o.render.tile_size;
     json["tile_overlap"] = o.render.tile_overlap;
   }
-  json["targets"] = !o.target_images.empty() ? "target_images " + o.target_images
-                    : !o.camera_path.empty() ? "camera_path " + o.camera_path
+  json["targets"] = !o.target_images.empty() ? "target_images"
+                    : !o.camera_path.empty() ? "camera_path"
                     : o.orbit > 0            ? "orbit " + std::to_string(o.orbit)
                                   : "interpolate " + std::to_string(o.interpolate);
-  // A changed target file (same name) is a different render too.
-  const std::string file = !o.target_images.empty() ? o.target_images : o.camera_path;
-  if (!file.empty()) json["targets_stamp"] = StampPaths({file});
+  const std::string targets_hash = TargetsHash(o);
+  if (!targets_hash.empty()) json["targets_hash"] = targets_hash;
   return json.dump(2) + "\n";
 }
 
@@ -342,6 +397,7 @@ int RunViewSynthesis(int argc, char** argv) {
       overwrite ? std::map<std::string, FrameReportRow>()
                 : ReadFrameReport(report_stem + ".csv");
   nlohmann::json report_extra = nlohmann::json::parse(settings);
+  if (!o.render.model_path.empty()) report_extra["model_path"] = o.render.model_path;
   report_extra["machine"] = DescribeMachine();
   TemporalSequence sequence(o.temporal);
   std::vector<FrameReportRow> report;

@@ -9,7 +9,9 @@
 // Renders the protocol's targets at the photos' size, scores them against the photos and
 // writes O/results.csv, O/summary.csv, O/results.md, O/contact_sheet.png and, for more
 // than one configuration, O/error_vs_time.png. Bad views are reported in their rows and
-// the others still evaluated; the exit status is 1 when any view failed.
+// the others still evaluated; the exit status is 1 when any view failed. A held-out image
+// SfM did not register is listed as skipped (status "skipped", the reason in "error"),
+// which is not a failure.
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -288,10 +290,13 @@ int RunViewSynthesisEval(int argc, char** argv) {
   }
   std::printf("wrote %s/results.csv, summary.csv, results.md\n", o.output_path.c_str());
 
+  for (const EvalTarget& t : targets) {
+    if (t.skipped) std::printf("skipped %s: %s\n", t.name.c_str(), t.error.c_str());
+  }
   int failed = 0;
   const ViewResult* first_failure = nullptr;
   for (const ViewResult& r : results) {
-    if (!r.ok()) {
+    if (r.failed()) {
       ++failed;
       if (!first_failure) first_failure = &r;
     }

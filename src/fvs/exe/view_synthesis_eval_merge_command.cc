@@ -121,7 +121,7 @@ int RunViewSynthesisEvalMerge(int argc, char** argv) {
     }
   }
   int failed = 0;
-  for (const ViewResult& r : results) failed += r.ok() ? 0 : 1;
+  for (const ViewResult& r : results) failed += r.failed() ? 1 : 0;
   std::printf("merged %zu rows (%d failed) from %zu folders into %s\n", results.size(),
               failed, inputs.size(), output_path.c_str());
   return 0;

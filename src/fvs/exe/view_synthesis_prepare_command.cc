@@ -71,9 +71,12 @@ int RunPrepare(int argc, char** argv) {
       "skipped; a killed run resumes.");
   options.AddRequired("image_path", &o.image_path, "folder of the input photos");
   options.AddRequired("workspace_path", &o.workspace_path, "output dense workspace");
-  options.AddDefault("Matching.type", &o.matcher,
-                     "auto (sequential for numbered video frames, else exhaustive up to "
-                     "150 images), exhaustive, sequential");
+  options.AddDefault(
+      "Matching.type", &o.matcher,
+      "auto (every pair up to 200 images, 1000 with a CUDA COLMAP; beyond, "
+      "sequential for consecutive numbered frames), exhaustive, sequential "
+      "(neighbours in name order, with loop closure); when mapping misses "
+      "photos after sequential, every pair is matched and mapped again");
   options.AddDefault("ImageReader.camera_model", &o.camera_model, "COLMAP camera model");
   options.AddDefault("ImageReader.single_camera", &o.single_camera,
                      "one camera for all photos");

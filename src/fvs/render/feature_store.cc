@@ -36,8 +36,7 @@ FeatureStore::FeatureStore(const std::string& dir, const std::string& model_path
                            const std::string& variant, const std::string& precision,
                            int64_t max_bytes)
     : dir_(dir), max_bytes_(max_bytes) {
-  const std::string weights = ReadFileToString(model_path);
-  weights_hash_ = HexHash(Hash64(weights.data(), weights.size()));
+  weights_hash_ = HexHash(HashFile(model_path));
   folder_ = JoinPaths(dir, variant + "-" + weights_hash_ + "-" + precision);
   std::error_code ec;
   std::filesystem::create_directories(folder_, ec);

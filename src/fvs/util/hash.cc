@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <cstring>
 
+#include "fvs/util/atomic_file.h"
+
 namespace fvs {
 
 uint64_t Hash64(const void* data, size_t bytes, uint64_t seed) {
@@ -21,6 +23,11 @@ uint64_t Hash64(const void* data, size_t bytes, uint64_t seed) {
   h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ULL;
   h = (h ^ (h >> 27)) * 0x94d049bb133111ebULL;
   return h ^ (h >> 31);
+}
+
+uint64_t HashFile(const std::string& path, uint64_t seed) {
+  const std::string bytes = ReadFileToString(path);
+  return Hash64(bytes.data(), bytes.size(), seed);
 }
 
 std::string HexHash(uint64_t hash) {
