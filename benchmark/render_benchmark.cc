@@ -29,10 +29,14 @@ int main(int argc, char** argv) {
   fvs::benchmark::CheckArgs(
       argc, argv,
       "usage: render_benchmark [--views N] [--frames F] [--max_k K] [--sizes "
-      "480x270,960x540] [--model_path weights.safetensors]",
-      {"--frames", "--max_k", "--model_path", "--sizes", "--views"});
+      "480x270,960x540] [--model_path weights.safetensors] [--precision fp32|bf16|fp16]",
+      {"--frames", "--max_k", "--model_path", "--precision", "--sizes", "--tile_overlap",
+       "--tile_size", "--views"});
   int num_views = 16, num_frames = 3, max_k = 8;
   std::string model_path;
+  std::string precision = "fp32";  // of the network: fp32, bf16 (CPU) or fp16 (CUDA)
+  fvs::RenderOptions defaults;
+  int tile_size = defaults.tile_size, tile_overlap = defaults.tile_overlap;
   std::vector<std::pair<int, int>> sizes = {{480, 270}, {960, 540}};
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
@@ -40,6 +44,9 @@ int main(int argc, char** argv) {
     if (a == "--frames") num_frames = std::atoi(v.c_str());
     if (a == "--max_k") max_k = std::atoi(v.c_str());
     if (a == "--model_path") model_path = v;
+    if (a == "--precision") precision = v;
+    if (a == "--tile_size") tile_size = std::atoi(v.c_str());
+    if (a == "--tile_overlap") tile_overlap = std::atoi(v.c_str());
     if (a == "--sizes") {
       sizes.clear();
       size_t p = 0;
@@ -90,6 +97,9 @@ int main(int argc, char** argv) {
           fvs::RenderOptions render;
           render.num_sources = k;
           render.model_path = model_path;
+          render.precision = precision;
+          render.tile_size = tile_size;
+          render.tile_overlap = tile_overlap;
           auto renderer = fvs::CreateMethod(method, render);
           fvs::RenderTimings sum;
           double psnr = 0, coverage = 0;

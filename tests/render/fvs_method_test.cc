@@ -249,6 +249,28 @@ TEST(FvsMethod, TiledBlendEqualsTheWholeTarget) {
       EXPECT_GT(MaxDifference(whole.color, seams.color), 0.0f);
     }
   }
+  // fvs_agg (random heads: context-dependent) in 3 x 3 tiles of a larger target with its
+  // own overlap: the tiles see all the context the whole target does.
+  const Scene large = testing::MakeTestScene(5, 96, 72);
+  const TargetView large_target = HeldOutTarget(large, 2);
+  RenderOptions options;
+  options.num_sources = 3;
+  {
+    // Its heads start at zero (the ULR blend, pixel by pixel): give them weights.
+    torch::manual_seed(3);
+    const ModelConfig config = ModelConfig::ForVariant("fvs_agg");
+    FvsNet net(config);
+    torch::NoGradGuard no_grad;
+    for (auto& p : net->parameters()) p.add_(torch::randn_like(p) * 0.05);
+    options.model_path = dir.path() + "/fvs_agg_random.safetensors";
+    SaveWeights(net, config, options.model_path, /*fp16=*/false);
+  }
+  options.tile_size = 0;
+  const RenderResult whole = CreateMethod("fvs", options)->Render(large, large_target);
+  options.tile_size = 32;
+  options.tile_overlap = -1;  // the network's own
+  const RenderResult tiled = CreateMethod("fvs", options)->Render(large, large_target);
+  EXPECT_LT(MaxDifference(whole.color, tiled.color), 1e-5f);
   RenderOptions bad;
   bad.tile_size = 3;
   EXPECT_THROW(bad.Check(), Error);

@@ -283,9 +283,11 @@ int RunViewSynthesis(int argc, char** argv) {
                      "used out first)");
   options.AddDefault("tile_size", &o.render.tile_size,
                      "--method fvs: blend targets larger than this in tiles of at most "
-                     "this size, to bound memory (0: never)");
+                     "this size, to bound memory and stay in cache (0: never; -1: the "
+                     "network's own, 160 for fvs_agg, 512 for the others)");
   options.AddDefault("tile_overlap", &o.render.tile_overlap,
-                     "--method fvs: pixels of context around each tile");
+                     "--method fvs: pixels of context around each tile (-1: the "
+                     "network's own, 24 for fvs_agg, 32 for the others)");
   options.AddDefault("num_threads", &o.render.num_threads, "threads (0: all cores)");
   options.AddDefault(
       "video", &o.video,

@@ -71,17 +71,24 @@ std::vector<Tile> Tiles(int width, int height, int tile_size, int overlap) {
   if (tile_size <= 0 || (width <= tile_size && height <= tile_size)) {
     return {Tile{0, height, 0, width, 0, height, 0, width}};
   }
-  // Equal tiles rather than full ones and a sliver.
+  // Equal tiles rather than full ones and a sliver, split at even pixels: with an even
+  // overlap every context box then starts where the whole target's 2x down-sampling
+  // pairs pixels, so a tile computes what the whole target would (fvs_agg's
+  // half-resolution branches; tested).
   const int rows = (height + tile_size - 1) / tile_size;
   const int cols = (width + tile_size - 1) / tile_size;
+  auto split = [](int size, int i, int n) {
+    return i == n ? size : size * i / n / 2 * 2;
+  };
   std::vector<Tile> tiles;
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       Tile t;
-      t.y0 = height * r / rows;
-      t.y1 = height * (r + 1) / rows;
-      t.x0 = width * c / cols;
-      t.x1 = width * (c + 1) / cols;
+      t.y0 = split(height, r, rows);
+      t.y1 = split(height, r + 1, rows);
+      t.x0 = split(width, c, cols);
+      t.x1 = split(width, c + 1, cols);
+      if (t.y1 <= t.y0 || t.x1 <= t.x0) continue;
       t.cy0 = std::max(0, t.y0 - overlap);
       t.cy1 = std::min(height, t.y1 + overlap);
       t.cx0 = std::max(0, t.x0 - overlap);
@@ -103,6 +110,14 @@ class FvsMethod : public Method {
         dtype_(dtype) {
     net_->eval();
     net_->to(device_, dtype_);
+    // Tiles by default: fvs_agg's narrow full-resolution layers are bound by memory
+    // traffic, and tiles of 160 pixels that stay in cache render 480x270 at K = 5 about
+    // 4x faster than one 512 tile (benchmark/README_render.md); its receptive field
+    // reaches less than 24 pixels (the tiled-equals-whole test). The encoder-decoder
+    // variants keep 512 and 32.
+    const bool aggregate = config_.blender == "aggregate";
+    if (options_.tile_size < 0) options_.tile_size = aggregate ? 160 : 512;
+    if (options_.tile_overlap < 0) options_.tile_overlap = aggregate ? 24 : 32;
     // Channels-last: oneDNN's convolutions run 15-25 % faster on it on this CPU (measured
     // on the demo path, 480x360, K = 5: 3.0-3.3 s against 3.4-4.4 s per frame, noisy
     // machine), and it is the layout CUDA's tensor cores want.

@@ -30,9 +30,9 @@ void RenderOptions::Check() const {
   Require(ulr_num_blend >= 1, "ulr_num_blend", "must be at least 1");
   Require(source_hysteresis >= 0 && std::isfinite(source_hysteresis),
           "--source_hysteresis", "must be finite and non-negative");
-  Require(tile_size == 0 || tile_size >= 8, "--tile_size",
-          "must be 0 (off) or at least 8");
-  Require(tile_overlap >= 0, "--tile_overlap", "must be non-negative");
+  Require(tile_size == -1 || tile_size == 0 || tile_size >= 8, "--tile_size",
+          "must be -1 (the network's own), 0 (off) or at least 8");
+  Require(tile_overlap >= -1, "--tile_overlap", "must be -1 (the network's own) or >= 0");
   Require(feature_cache_mb >= 0, "--feature_cache_mb", "must be non-negative");
   Require(feature_cache_disk_mb >= 0, "--feature_cache_disk_mb", "must be non-negative");
   Require(device == "auto" || device == "cpu" || device == "cuda", "--device",

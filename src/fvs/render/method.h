@@ -81,9 +81,10 @@ struct RenderOptions {
   // (the blending U-Net's activations and the warped features scale with the pixels of a
   // tile, not of the target). Also faster on a CPU (cache): fvs_fast at 1920x1080, K = 5,
   // 2 cores: untiled 41 s per frame and 7.5 GB, tiles of 1024 34 s and 3.1 GB, of 512
-  // 27 s and 2.4 GB. 0 = never tile.
-  int tile_size = 512;
-  int tile_overlap = 32;
+  // 27 s and 2.4 GB. 0 = never tile; -1 (default) = the network's own (fvs_agg 160 and
+  // 24, the others 512 and 32; render/fvs_method.cc).
+  int tile_size = -1;
+  int tile_overlap = -1;
   void Check() const;
 };
 
