@@ -30,9 +30,9 @@ ok "built $(basename "$DEB") ($(du -h "$DEB" | cut -f1))"
 # 2. Control fields: the name, and Depends on what the binaries need at run time.
 [[ "$(dpkg-deb -f "$DEB" Package)" == colmap-fvs ]] || fail "Package is not colmap-fvs"
 depends="$(dpkg-deb -f "$DEB" Depends)"
-for want in colmap libtorch libopenimageio libqt5widgets5 libqt5opengl5 libceres libc6 \
+for want in colmap libtorch libopenimageio libqt5widgets5 libqt5gui5 libgoogle-glog libc6 \
   libstdc++6; do
-  grep -Eq "(^|, )$want[^,]*" <<<"$depends" || fail "Depends lacks $want: $depends"
+  [[ ", $depends" == *", $want"* ]] || fail "Depends lacks $want: $depends"
 done
 ok "Depends: $depends"
 ok "Recommends: $(dpkg-deb -f "$DEB" Recommends)"
