@@ -22,10 +22,15 @@ set(FVS_INSTALL_DOC_DIR ${CMAKE_INSTALL_DATADIR}/doc/colmap-fvs)
 
 # Build-tree binaries find the source tree's models/ the way installed ones find theirs:
 # build/bin/../share/colmap-fvs/models is a link to it (no source path is compiled in).
+set(fvs_models_link ${CMAKE_BINARY_DIR}/share/colmap-fvs/models)
 file(MAKE_DIRECTORY ${CMAKE_BINARY_DIR}/share/colmap-fvs)
-if(NOT IS_SYMLINK ${CMAKE_BINARY_DIR}/share/colmap-fvs/models)
-  file(CREATE_LINK ${CMAKE_SOURCE_DIR}/models ${CMAKE_BINARY_DIR}/share/colmap-fvs/models
-       SYMBOLIC)
+set(fvs_models_target "")
+if(IS_SYMLINK ${fvs_models_link})
+  file(READ_SYMLINK ${fvs_models_link} fvs_models_target)
+endif()
+if(NOT fvs_models_target STREQUAL "${CMAKE_SOURCE_DIR}/models")
+  file(REMOVE ${fvs_models_link})
+  file(CREATE_LINK ${CMAKE_SOURCE_DIR}/models ${fvs_models_link} SYMBOLIC)
 endif()
 
 # Paths as seen by the install script: DESTDIR (set by CPack) + the prefix.
