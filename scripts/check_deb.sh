@@ -153,4 +153,45 @@ else
   note "a shipped model (models/ holds none; tests/exe/install_test.cc checks the lookup)"
 fi
 ok "unpacked binaries ran from $ROOT ($hidden): help, COLMAP found, view_synthesis_synthetic, view_synthesis --method ulr"
+# 8. A real `apt install ./colmap-fvs_*.deb` (and `apt remove`), inside a throwaway copy of
+# this system: an overlay of / whose changes go to a tmpfs, in a private mount namespace, with
+# /work (the checkouts) covered. Offline, so it shows the install on a machine that already
+# has every dependency, not the download. Needs root and overlayfs; skipped otherwise.
+OV="$TMP/overlay"
+mkdir -p "$OV/changes" "$OV/root"
+cat >"$TMP/in_chroot.sh" <<'IN'
+set -eu
+export PATH=/usr/sbin:/usr/bin:/sbin:/bin DEBIAN_FRONTEND=noninteractive
+before="$(md5sum /usr/bin/colmap)"
+apt-get install -y --no-install-recommends /var/tmp/check_deb/*.deb >/apt_install.log 2>&1 || { cat /apt_install.log; exit 11; }
+dpkg -s colmap-fvs | grep -q '^Status: install ok installed' || exit 12
+[ "$(md5sum /usr/bin/colmap)" = "$before" ] || { echo "/usr/bin/colmap changed"; exit 13; }
+cd /tmp
+FVS_QUIET=1 QT_QPA_PLATFORM=offscreen colmap-fvs help >/help.log 2>&1 || { cat /help.log; exit 14; }
+grep -q feature_extractor /help.log && grep -q view_synthesis_prepare /help.log || exit 15
+FVS_QUIET=1 colmap-fvs view_synthesis_synthetic --output_path /tmp/ws --SyntheticScene.num_views 6 \
+  --SyntheticScene.width 96 --SyntheticScene.height 72 --SyntheticScene.write_proxy_mesh 1 || exit 16
+FVS_QUIET=1 OMP_WAIT_POLICY=PASSIVE colmap-fvs view_synthesis --workspace_path /tmp/ws \
+  --output_path /tmp/ulr --method ulr --orbit 1 || exit 17
+man -w colmap-fvs >/dev/null 2>&1 || [ -f /usr/share/man/man1/colmap-fvs.1 ] || exit 18
+apt-get remove -y colmap-fvs >/apt_remove.log 2>&1 || { cat /apt_remove.log; exit 19; }
+[ ! -e /usr/bin/colmap-fvs ] && [ ! -e /usr/lib/colmap-fvs ] && [ -x /usr/bin/colmap ] || exit 20
+IN
+if [[ $EUID -eq 0 ]] && unshare -m sh -c "mount -t tmpfs none '$OV/changes' && mkdir '$OV/changes/u' '$OV/changes/w' && mount -t overlay overlay -o 'lowerdir=/,upperdir=$OV/changes/u,workdir=$OV/changes/w' '$OV/root'" 2>/dev/null; then
+  unshare -m sh -c "
+    set -e
+    mount -t tmpfs none '$OV/changes'; mkdir '$OV/changes/u' '$OV/changes/w'
+    mount -t overlay overlay -o 'lowerdir=/,upperdir=$OV/changes/u,workdir=$OV/changes/w' '$OV/root'
+    mount -t proc proc '$OV/root/proc'; mount --rbind /dev '$OV/root/dev'; mount --rbind /sys '$OV/root/sys'
+    mount -t tmpfs none '$OV/root/tmp'
+    [ -d '$OV/root/work' ] && mount -t tmpfs none '$OV/root/work'
+    mkdir -p '$OV/root/var/tmp/check_deb'; cp '$DEB' '$OV/root/var/tmp/check_deb/'
+    cp '$TMP/in_chroot.sh' '$OV/root/in_chroot.sh'
+    exec chroot '$OV/root' sh /in_chroot.sh" >"$TMP/overlay.log" 2>&1 ||
+    { cat "$TMP/overlay.log" >&2; fail "apt install / run / apt remove in an overlay of this system"; }
+  ok "apt install ./$(basename "$DEB") in a throwaway overlay of this system (/work hidden): installed, /usr/bin/colmap untouched, colmap-fvs help/view_synthesis_synthetic/view_synthesis ran, apt remove left nothing"
+else
+  note "a real apt install (needs root and overlayfs in a private mount namespace)"
+fi
+
 echo "check_deb: all checks passed: $DEB"
