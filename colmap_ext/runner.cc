@@ -57,14 +57,22 @@ std::vector<std::string> SplitPath(const std::string& list) {
   return dirs;
 }
 
-// Our own front door (build/bin/colmap) has a `.fvs_front_door` marker beside it; running
-// it from here would recurse. Checked for the path as given and for its resolved target.
+// Our own front door (build/bin/colmap, an installed <prefix>/bin/colmap) has a
+// `.fvs_front_door` marker beside it; running it from here would recurse. Checked for the
+// path as given and for its resolved target. A path that resolves to the running
+// executable itself (e.g. a user's own `colmap` link to /usr/bin/colmap-fvs, which has no
+// marker: /usr/bin also holds Debian's real colmap) counts too.
 bool IsFrontDoor(const std::string& path) {
   struct stat st;
   if (::stat((DirName(path) + "/.fvs_front_door").c_str(), &st) == 0) return true;
   char resolved[PATH_MAX];
   if (::realpath(path.c_str(), resolved) != nullptr) {
     if (::stat((DirName(resolved) + "/.fvs_front_door").c_str(), &st) == 0) return true;
+    char self[PATH_MAX];
+    if (::realpath("/proc/self/exe", self) != nullptr &&
+        std::strcmp(self, resolved) == 0) {
+      return true;
+    }
   }
   return false;
 }

@@ -297,7 +297,6 @@ std::string ShippedModelPath(const std::string& variant) {
   std::error_code error;
   const fs::path exe = fs::read_symlink("/proc/self/exe", error);
   if (!error) folders.push_back(exe.parent_path() / "../share/colmap-fvs/models");
-  folders.push_back(FVS_SOURCE_MODEL_DIR);
   for (const fs::path& folder : folders) {
     const fs::path file = folder / (variant + ".safetensors");
     if (fs::is_regular_file(file, error)) return file.lexically_normal().string();

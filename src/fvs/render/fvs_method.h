@@ -18,8 +18,9 @@ std::unique_ptr<Method> CreateFvsMethod(const std::string& requested,
                                         const RenderOptions& options);
 
 // The shipped weights of a variant, <variant>.safetensors, in the first folder that has
-// them: $FVS_MODEL_DIR, <executable>/../share/colmap-fvs/models (an installed tree), the
-// source tree's models/ (a build-tree binary). Empty when none has them.
+// them: $FVS_MODEL_DIR, then <executable>/../share/colmap-fvs/models: <prefix>/share/...
+// in an installed tree, build/share/colmap-fvs/models (a link to the source tree's
+// models/) in the build tree. No source path is compiled in. Empty when none has them.
 std::string ShippedModelPath(const std::string& variant);
 
 // The weights a network method uses without --model_path: the scene's fine-tuned
