@@ -506,7 +506,8 @@ TrainSummary Trainer::Run() {
     if (step_ % options_.log_every == 0 || step_ == options_.max_steps ||
         budget_spent()) {
       const double rate = window_steps * options_.batch_size / window.Seconds();
-      double eta = (options_.max_steps - step_) * options_.batch_size / rate;
+      double eta =
+          static_cast<double>(options_.max_steps - step_) * options_.batch_size / rate;
       if (budget_seconds > 0) eta = std::min(eta, budget_seconds - train_seconds_);
       summary.final_loss = window_loss / window_steps;
       if (!options_.quiet) {
