@@ -23,7 +23,8 @@ LOSS="${FVS_LOSS:-$([[ -n "$LPIPS" ]] && echo l1+ssim+lpips || echo l1+ssim)}"
 [[ -x "$COLMAP" ]] || scripts/build.sh
 mkdir -p "$WORK"/{bin,images,ws,packed,runs}
 # A copy, so that rebuilding build/ never changes the binary under a running stage.
-cp "$COLMAP" "$WORK/bin/colmap"
+# (Copied then renamed: a binary still running from an earlier run is "text file busy".)
+cp "$COLMAP" "$WORK/bin/colmap.tmp" && mv -f "$WORK/bin/colmap.tmp" "$WORK/bin/colmap"
 cd "$WORK"
 
 # scene:every n-th photo:holdout (1 = every 5th of the chosen photos held out).

@@ -15,7 +15,7 @@ COLMAP="$PWD/build/bin/colmap"
 [[ -x "$COLMAP" ]] || scripts/build.sh
 mkdir -p "$WORK"/{bin,images,ws,packed,runs}
 # A copy, so that rebuilding build/ never changes the binary under a running stage.
-cp "$COLMAP" "$WORK/bin/colmap"
+cp "$COLMAP" "$WORK/bin/colmap.tmp" && mv -f "$WORK/bin/colmap.tmp" "$WORK/bin/colmap"  # a running binary is busy
 cd "$WORK"
 
 # Real scenes (name:every n-th photo). Validation: fox and middlebury_temple (README of
