@@ -37,7 +37,6 @@ fi
 STAGE=${FVS_PACK_STAGE:-$ROOT/build-gpu-pack}
 mkdir -p "$OUT_DIR" "$STAGE"
 OUT_DIR=$(cd "$OUT_DIR" && pwd)
-REL=$(python3 -c 'import os,sys;print(os.path.relpath(sys.argv[1],sys.argv[2]))' "$OUT_DIR" "$ROOT")
 rm -rf "$OUT_DIR/packed"
 : >"$OUT_DIR/train.txt.tmp"
 : >"$OUT_DIR/val.txt.tmp"
@@ -56,9 +55,9 @@ for ws in "$WS_ROOT"/*/; do
     echo "$SCALE" >"$out/.scale"
   fi
   if [[ " $VAL_SCENES " == *" $scene "* ]]; then
-    echo "$REL/packed/$scene" >>"$OUT_DIR/val.txt.tmp"
+    echo "packed/$scene" >>"$OUT_DIR/val.txt.tmp"
   else
-    echo "$REL/packed/$scene" >>"$OUT_DIR/train.txt.tmp"
+    echo "packed/$scene" >>"$OUT_DIR/train.txt.tmp"
   fi
 done
 mv "$OUT_DIR/train.txt.tmp" "$OUT_DIR/train.txt"
