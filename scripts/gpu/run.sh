@@ -195,6 +195,12 @@ used = [os.path.getsize(os.path.join(out, f)) + 2 * 2**20 for f in os.listdir(ou
 count, size = len(used), sum(used)
 def put(src, name):
     global count, size
+    raw = os.path.getsize(src)
+    # xz takes weights to no less than about 85 %: skip early what cannot fit (a 400 MB
+    # checkpoint would take minutes to compress for nothing).
+    if size + 0.8 * raw > TOTAL or count + max(1, int(0.8 * raw) // FILE + 1) > NFILES:
+        print("does not fit, left behind: %s (%d bytes)" % (name, raw))
+        return
     data = open(src, "rb").read()
     if len(data) > FILE:
         data = lzma.compress(data, preset=6)
