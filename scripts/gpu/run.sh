@@ -25,9 +25,10 @@
 # minutes of all invocations included). Without one, model.safetensors there (or its .xz
 # parts) starts the run from those weights (--Train.init_weights: a warm start with a fresh
 # optimiser, not an exact resume). The reference `fvs` (33.7 M parameters) has a checkpoint
-# of about 400 MB (fp32 weights + Adam moments), which can neither come back through $OUT
-# nor travel in the 64 MiB carry: for it, only the warm start from the fp16 weights is
-# possible between two device windows. Smaller variants resume exactly.
+# of 405 MB (fp32 weights + Adam moments), which can neither come back through $OUT nor
+# travel in the 64 MiB carry; its fp16 weights (67.5 MB) come back as ~59 MB of xz parts
+# but do not travel back in beside gpu_data/ (33 MB) either. So `fvs` trains within one
+# window only; smaller variants resume exactly.
 #
 # NOT DONE HERE, stated plainly:
 #   - bf16 autocast: the trainer has no mixed-precision option (trains in fp32; TF32 is
