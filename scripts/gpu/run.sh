@@ -112,6 +112,8 @@ if [[ -z ${FVS_CXX_STANDARD:-} ]]; then
     FVS_CXX_STANDARD=20
   fi
 fi
+# --no-as-needed: the trainer references no libtorch_cuda symbol, and a linker that drops
+# unreferenced libraries would leave LibTorch without its CUDA backend at run time.
 GEN=()
 command -v ninja >/dev/null && GEN=(-G Ninja)
 step "configure (C++$FVS_CXX_STANDARD)"
@@ -120,6 +122,7 @@ export TORCH_CUDA_ARCH_LIST=${TORCH_CUDA_ARCH_LIST:-9.0}
 cmake -S "$ROOT" -B "$BUILD" "${GEN[@]}" -DCMAKE_BUILD_TYPE=Release \
   -DFVS_TRAINER_ONLY=ON -DFVS_WITH_GUI=OFF -DFVS_BUILD_TESTS=OFF -DFVS_BUILD_BENCHMARKS=OFF \
   -DCMAKE_CXX_STANDARD="$FVS_CXX_STANDARD" \
+  -DCMAKE_EXE_LINKER_FLAGS="-Wl,--no-as-needed" \
   -DCMAKE_PREFIX_PATH="${TORCH_PREFIX}${EXTRA_PREFIX}" "${EIGEN_ARGS[@]}" \
   ${FVS_CMAKE_ARGS:-} >"$OUT/configure.log" 2>&1 ||
   { tail -40 "$OUT/configure.log"; die "configure"; }
