@@ -43,17 +43,25 @@ std::string Fingerprint(const std::string& root, const std::vector<std::string>&
   return out;
 }
 
+// The front door as a shell command, quiet and without a display.
+std::string FrontDoorCommand() {
+  return "QT_QPA_PLATFORM=offscreen FVS_QUIET=1 '" + FrontDoorBinary() + "'";
+}
+
+// Ten generated 320x240 views in `folder` (images/ and the exact model).
+bool MakeTenViewScene(const std::string& colmap, const std::string& folder,
+                      std::string* log) {
+  return RunShell(colmap + " view_synthesis_synthetic --output_path " + folder +
+                      " --SyntheticScene.num_views 10 --SyntheticScene.width 320"
+                      " --SyntheticScene.height 240",
+                  log) == 0;
+}
+
 TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
   TempDir dir;
-  const std::string colmap =
-      "QT_QPA_PLATFORM=offscreen FVS_QUIET=1 '" + FrontDoorBinary() + "'";
+  const std::string colmap = FrontDoorCommand();
   std::string log;
-  ASSERT_EQ(RunShell(colmap + " view_synthesis_synthetic --output_path " + dir / "scene" +
-                         " --SyntheticScene.num_views 10 --SyntheticScene.width 320"
-                         " --SyntheticScene.height 240",
-                     &log),
-            0)
-      << log;
+  ASSERT_TRUE(MakeTenViewScene(colmap, dir / "scene", &log)) << log;
   const std::string prepare = colmap + " view_synthesis_prepare --image_path " +
                               dir / "scene/images" + " --workspace_path " + dir / "ws" +
                               " --holdout_images frame_0009.png";
@@ -116,15 +124,9 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
 // evaluation evaluates the other held-out view and lists this one as skipped.
 TEST(PrepareEndToEnd, UnregisteredHoldoutIsAWarningAndEvaluationSkipsIt) {
   TempDir dir;
-  const std::string colmap =
-      "QT_QPA_PLATFORM=offscreen FVS_QUIET=1 '" + FrontDoorBinary() + "'";
+  const std::string colmap = FrontDoorCommand();
   std::string log;
-  ASSERT_EQ(RunShell(colmap + " view_synthesis_synthetic --output_path " + dir / "scene" +
-                         " --SyntheticScene.num_views 10 --SyntheticScene.width 320"
-                         " --SyntheticScene.height 240",
-                     &log),
-            0)
-      << log;
+  ASSERT_TRUE(MakeTenViewScene(colmap, dir / "scene", &log)) << log;
   Image gradient(320, 240, 3);
   for (int y = 0; y < 240; ++y) {
     for (int x = 0; x < 320; ++x) {
