@@ -52,18 +52,13 @@ void WriteState(const fs::path& file, const FinetuneState& s) {
   WriteFileAtomic(file.string(), [&](std::ostream& out) { out << j.dump(2) << "\n"; });
 }
 
-std::string FileHash(const std::string& path) {
-  const std::string bytes = ReadFileToString(path);
-  return HexHash(Hash64(bytes.data(), bytes.size()));
-}
-
 // Packs the workspace unless a pack at this scale exists; returns the seconds it took
-// (now or in the run that made it).
+// (now or in the run that made it). *packed_now: whether this call packed.
 double EnsurePack(const FinetuneOptions& o, const fs::path& pack_dir,
-                  FinetuneState* state) {
-  if (fs::is_regular_file(pack_dir / kPackedSceneFile) &&
-      state->pack_scale == o.pack_scale)
-    return state->pack_seconds;
+                  FinetuneState* state, bool* packed_now) {
+  *packed_now = !(fs::is_regular_file(pack_dir / kPackedSceneFile) &&
+                  state->pack_scale == o.pack_scale);
+  if (!*packed_now) return state->pack_seconds;
   Timer timer;
   if (!o.quiet)
     std::cerr << "[finetune] packing the scene at scale " << o.pack_scale << "\n";
@@ -155,7 +150,8 @@ FinetuneSummary RunFinetune(const FinetuneOptions& o) {
   FinetuneState state = ReadState(state_file);
   FinetuneSummary summary;
   summary.init_path = o.model_path;
-  const std::string init_hash = o.model_path.empty() ? "" : FileHash(o.model_path);
+  const std::string init_hash =
+      o.model_path.empty() ? "" : HexHash(HashFile(o.model_path));
   if (state.init_hash != init_hash || state.variant != o.variant) {
     // Other starting weights: the old run is of no use (the pack still is).
     fs::remove_all(root / "run");
@@ -176,16 +172,15 @@ FinetuneSummary RunFinetune(const FinetuneOptions& o) {
     std::cerr << "[finetune] no generic " << o.variant
               << " weights: starting from the variant's initial weights\n";
   }
-  const bool packed_before = fs::is_regular_file(root / "pack" / kPackedSceneFile) &&
-                             state.pack_scale == o.pack_scale;
-  summary.pack_seconds = EnsurePack(o, root / "pack", &state);
+  bool packed_now = false;
+  summary.pack_seconds = EnsurePack(o, root / "pack", &state, &packed_now);
   WriteState(state_file, state);
   WriteFileAtomic((root / "scenes.txt").string(), [](std::ostream& f) { f << "pack\n"; });
 
   Trainer trainer(MakeTrainOptions(o, root));
   // The budget less packing (whichever run packed) and this run's own setup is what the
   // training of all runs together may take: a rerun with a larger budget trains on.
-  const double setup = timer.Seconds() - (packed_before ? 0.0 : summary.pack_seconds);
+  const double setup = timer.Seconds() - (packed_now ? summary.pack_seconds : 0.0);
   trainer.SetMaxTrainSeconds(
       std::max(1e-3, o.minutes * 60 - summary.pack_seconds - setup));
   const TrainSummary trained = trainer.Run();
