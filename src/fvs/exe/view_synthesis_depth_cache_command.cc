@@ -1,11 +1,14 @@
 // colmap view_synthesis_depth_cache --workspace_path W: renders the depth of every source
 // view from W/meshed-delaunay.ply into W/fvs/depth/ (reusing what is current). The last
-// stage of view_synthesis_prepare; on its own after a mesh was replaced.
+// stage of view_synthesis_prepare; on its own after a mesh was replaced. Prints how much
+// of the photos the mesh covers and writes it per view to W/fvs/depth/coverage.json.
 #include <iostream>
 
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/option_manager.h"
+#include "fvs/scene/mesh_coverage.h"
 #include "fvs/scene/scene.h"
+#include "fvs/util/atomic_file.h"
 #include "fvs/util/progress.h"
 
 namespace fvs {
@@ -29,6 +32,10 @@ int RunDepthCache(int argc, char** argv) {
             << scene.num_depths_computed() << " rendered, "
             << scene.num_views() - scene.num_depths_computed() << " reused, "
             << timer.Seconds() << " s\n";
+  const MeshCoverage coverage = MeasureMeshCoverage(scene);
+  std::cerr << coverage.Summary() << "\n";
+  WriteFileAtomic(scene.workspace_path() + "/fvs/depth/coverage.json",
+                  [&](std::ostream& out) { out << coverage.ToJson() << "\n"; });
   return 0;
 }
 
