@@ -200,7 +200,8 @@ QWidget* MainWindow::BuildControls() {
 
   num_sources_ = new QSpinBox(render_box);
   num_sources_->setObjectName("num_sources");
-  num_sources_->setRange(1, 16);
+  num_sources_->setRange(0, 16);
+  num_sources_->setSpecialValueText("auto");  // 0: adaptive K (RenderOptions)
   num_sources_->setValue(5);
   form->addRow("Sources (K)", num_sources_);
   auto* size_row = new QHBoxLayout();

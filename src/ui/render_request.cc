@@ -9,7 +9,7 @@ namespace fvs::ui {
 
 void RenderRequest::Check() const {
   Require(!method.empty(), "method", "no rendering method chosen");
-  Require(num_sources >= 1, "K", "needs at least one source");
+  Require(num_sources >= 0, "K", "needs at least one source, or auto (0)");
   Require(width >= 8 && height >= 8 && width <= 8192 && height <= 8192, "resolution",
           "width and height must be between 8 and 8192 pixels");
 }

@@ -164,7 +164,7 @@ TEST(Report, SummaryMeansAndParetoFront) {
 TEST(Report, CsvRoundTripKeepsNotAvailableAndErrors) {
   testing::TempDir dir;
   std::vector<ViewResult> rows = {Row("ulr", 5, "dir/a b.png", 23.456789, 0.25),
-                                  Row("ulr", 5, "x,\"y\".png", 0, 0)};
+                                  Row("ulr", 0, "x,\"y\".png", 0, 0)};
   rows[0].lpips = 0.123456;
   rows[0].config.scale = 0.5;
   rows[0].geometry_holdout = true;
@@ -188,6 +188,7 @@ TEST(Report, CsvRoundTripKeepsNotAvailableAndErrors) {
   EXPECT_TRUE(std::isnan(back[1].infinity_pixels));
   EXPECT_EQ(back[1].target, rows[1].target);
   EXPECT_EQ(back[1].error, rows[1].error);
+  EXPECT_EQ(back[1].config.num_sources, 0);  // adaptive K, "auto" in the file
   EXPECT_FALSE(back[1].ok());
   EXPECT_TRUE(std::isnan(back[1].psnr));
   EXPECT_NE(testing::ReadTextFile(dir / "results.csv").find(",n/a,"), std::string::npos);
@@ -237,8 +238,18 @@ TEST(Sweep, PlansEveryCombinationAndSkipsNetworksWithoutWeights) {
   EXPECT_EQ(plan.configs[5].Slug(), "ulr_k3_s0p5");
   ASSERT_EQ(plan.notes.size(), 1u);
   EXPECT_NE(plan.notes[0].find("fvs_fast: skipped"), std::string::npos);
-  o.num_sources = "0";
+  o.num_sources = "0";  // the adaptive K is spelled "auto" in lists and tables
   EXPECT_THROW(PlanSweep(o), Error);
+  o.num_sources = "3,auto";
+  const SweepPlan adaptive = PlanSweep(o);
+  ASSERT_EQ(adaptive.configs.size(), 2u + 4u);
+  EXPECT_EQ(adaptive.configs[3].num_sources, 0);
+  EXPECT_EQ(adaptive.configs[3].Label(), "ulr K=auto s=1");
+  EXPECT_EQ(adaptive.configs[3].Slug(), "ulr_kauto_s1");
+  EXPECT_EQ(ParseNumSources(FormatNumSources(0), "t"), 0);
+  EXPECT_EQ(ParseNumSources(FormatNumSources(7), "t"), 7);
+  EXPECT_THROW(ParseNumSources("-2", "t"), Error);
+  EXPECT_THROW(ParseNumSources("5x", "t"), Error);
   o.num_sources = "1";
   o.precisions = "fp8";
   EXPECT_THROW(PlanSweep(o), Error);

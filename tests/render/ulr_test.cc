@@ -123,6 +123,30 @@ TEST(RenderTest, HeldOutViewMatchesGroundTruth) {
   EXPECT_GE(sum_ulr / 3, sum_nearest / 3 - 0.5);
 }
 
+// The adaptive K (num_sources 0) renders a held-out view with between min_k and
+// max_num_sources sources, no worse than a fixed K of as many, and every method takes it.
+TEST(RenderTest, AdaptiveKRendersWithTheSourcesThatAddCoverage) {
+  const Scene scene = MakeTestScene(12, 96, 72);
+  TargetView view;
+  view.camera = scene.view(5).camera;
+  view.exclude_views = {5};
+  RenderOptions adaptive;
+  adaptive.num_sources = 0;
+  adaptive.max_num_sources = 8;
+  const RenderResult r = RenderWith("ulr", scene, view, adaptive);
+  ExpectFiniteResult(r);
+  EXPECT_GE(r.sources.size(), 2u);
+  EXPECT_LE(r.sources.size(), 8u);
+  RenderOptions fixed;
+  fixed.num_sources = static_cast<int>(r.sources.size());
+  const RenderResult f = RenderWith("ulr", scene, view, fixed);
+  const Image truth = scene.SourceImage(5);
+  std::printf("adaptive K = %zu: %.2f dB; fixed K: %.2f dB\n", r.sources.size(),
+              Psnr(r.color, truth), Psnr(f.color, truth));
+  EXPECT_GT(Psnr(r.color, truth), Psnr(f.color, truth) - 1.0);
+  EXPECT_EQ(RenderWith("nearest", scene, view, adaptive).sources.size(), 1u);
+}
+
 TEST(RenderTest, TargetCoincidingWithASourceReproducesIt) {
   const Scene scene = MakeTestScene(4, 64, 48);
   TargetView view;
@@ -233,7 +257,7 @@ TEST(MethodRegistryTest, KnownMethodsAndClearErrors) {
   }
   EXPECT_THROW(CreateMethod("magic", RenderOptions{}), Error);
   RenderOptions bad;
-  bad.num_sources = 0;
+  bad.num_sources = -1;  // 0 is the adaptive K
   EXPECT_THROW(CreateMethod("ulr", bad), Error);
   // A method registered from outside (as the network will be) is found by name.
   struct Constant : Method {

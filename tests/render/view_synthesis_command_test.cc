@@ -201,7 +201,7 @@ TEST_F(ViewSynthesisCommandTest, BadInputIsOneLineAndNonZeroExit) {
   expect_failure("--target_images " + dir_ / "zero/images.txt" + out, "image size");
   expect_failure("--orbit 2 --method fvs" + out, "method fvs needs model weights");
   expect_failure("--orbit 2 --camera_path x.json" + out, "exactly one of");
-  expect_failure("--orbit 2 --num_sources 0" + out, "num_sources");
+  expect_failure("--orbit 2 --num_sources -1" + out, "num_sources");
   fs::remove(ws_ + "/meshed-delaunay.ply");
   expect_failure("--orbit 2" + out, "no proxy mesh");
 }

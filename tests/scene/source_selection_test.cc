@@ -1,6 +1,6 @@
 // Source selection on the in-memory test world: ranking by overlap, exclusion, depth
 // tolerance, sources that see nothing, K larger than the scene, threads not changing
-// results.
+// results, the background at infinity, the adaptive K.
 #include "fvs/scene/source_selection.h"
 
 #include <gtest/gtest.h>
@@ -88,6 +88,96 @@ TEST(SourceSelectionTest, ThreadCountDoesNotChangeTheResult) {
     EXPECT_EQ(a[i].view_index, b[i].view_index);
     EXPECT_EQ(a[i].count, b[i].count);
   }
+}
+
+// A target of sky alone (no surface anywhere) still gets the sources that see its sky:
+// those looking the same way, with no surface there themselves, best overlap first; a
+// source looking away, or with a surface in front of the sky, sees none of it.
+TEST(SourceSelectionTest, RanksSourcesByWhatTheySeeAtInfinityWhenThereIsNoSurface) {
+  const Eigen::Vector3d eye(0, 0, 0);
+  const PinholeCamera target =
+      testing::LookAtCamera(eye, Eigen::Vector3d(0, 10, 0), 40, 30);
+  const PinholeCamera same = testing::LookAtCamera(eye + Eigen::Vector3d(1, 0, 0),
+                                                   Eigen::Vector3d(1, 10, 0), 40, 30);
+  const PinholeCamera turned =
+      testing::LookAtCamera(eye, Eigen::Vector3d(4, 10, 0), 40, 30);  // ~22 degrees
+  const PinholeCamera away =
+      testing::LookAtCamera(eye, Eigen::Vector3d(0, -10, 0), 40, 30);
+  const Image no_surface(40, 30, 1, 0.f);
+  const Image wall(40, 30, 1, 2.f);  // a surface in front of everything
+  const std::vector<PinholeCamera> sources = {away, turned, same, same};
+  const std::vector<const Image*> depths = {&no_surface, &no_surface, &no_surface, &wall};
+  SourceSelectionOptions options;
+  options.k = 5;
+  const auto chosen = SelectSources(target, no_surface, sources, depths, options);
+  ASSERT_EQ(chosen.size(), 2u);
+  EXPECT_EQ(chosen[0].view_index, 2);  // the same direction: every pixel
+  EXPECT_EQ(chosen[0].infinity_count, 40 * 30);
+  EXPECT_EQ(chosen[0].count, 0);
+  EXPECT_EQ(chosen[1].view_index, 1);
+  EXPECT_GT(chosen[1].infinity_count, 0);
+  EXPECT_LT(chosen[1].infinity_count, 40 * 30);
+}
+
+// The adaptive K: at least min_k, at most k, in ranking order, and every source beyond
+// min_k adds at least min_gain of the target's pixels that fewer than wanted_views
+// sources saw; with no gain asked for, every source that adds anything; with an
+// impossible gain, exactly min_k.
+TEST(SourceSelectionTest, AdaptiveKTakesSourcesWhileTheyAddCoverage) {
+  const Scene scene = MakeTestScene(12, 48, 36);
+  const PinholeCamera target = scene.ToSceneCamera(ArcCamera(0.05, 48, 36));
+  const Image depth = scene.RenderDepth(target);
+  SourceSelectionOptions options;
+  options.adaptive = true;
+  options.k = 8;
+  options.min_k = 2;
+  options.wanted_views = 2;
+  options.min_gain = 0.02;
+  const SourceRanking ranking = RankSources(scene, target, depth, options);
+  ASSERT_GT(ranking.ranked.size(), 8u);
+  EXPECT_EQ(ranking.num_pixels, 48 * 36);
+  const auto chosen = ChooseSources(ranking, ranking.ranked, options);
+  ASSERT_GE(chosen.size(), 2u);
+  ASSERT_LE(chosen.size(), 8u);
+  EXPECT_EQ(chosen[0].view_index, ranking.ranked[0].view_index);
+  EXPECT_EQ(chosen[1].view_index, ranking.ranked[1].view_index);
+  // Replay the rule: each later source's gain over the ones before it.
+  std::vector<int> views(ranking.num_pixels, 0);
+  const auto seen = [&](int view, int64_t i) {
+    return (ranking.seen[view][i >> 6] >> (i & 63)) & 1;
+  };
+  size_t next = 0;  // into chosen
+  for (const SourceScore& s : ranking.ranked) {
+    if (next == chosen.size()) break;
+    int64_t gain = 0;
+    for (int64_t i = 0; i < ranking.num_pixels; ++i) {
+      gain += seen(s.view_index, i) && views[i] < options.wanted_views;
+    }
+    const bool taken = chosen[next].view_index == s.view_index;
+    if (next >= 2) {
+      EXPECT_EQ(taken, gain >= options.min_gain * ranking.num_pixels && gain > 0)
+          << "view " << s.view_index << " gain " << gain;
+    }
+    if (!taken) continue;
+    for (int64_t i = 0; i < ranking.num_pixels; ++i) views[i] += seen(s.view_index, i);
+    ++next;
+  }
+  EXPECT_EQ(next, chosen.size());
+
+  options.min_gain = 1.0;
+  EXPECT_EQ(ChooseSources(ranking, ranking.ranked, options).size(), 2u);
+  options.min_gain = 0;
+  options.wanted_views = 255;
+  EXPECT_EQ(ChooseSources(ranking, ranking.ranked, options).size(), 8u);
+  // Fixed K is the top K of the same ranking.
+  options.adaptive = false;
+  options.k = 3;
+  const auto top = ChooseSources(ranking, ranking.ranked, options);
+  ASSERT_EQ(top.size(), 3u);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(top[i].view_index, ranking.ranked[i].view_index);
+  SourceSelectionOptions bad;
+  bad.min_gain = 1.5;
+  EXPECT_THROW(bad.Check(), Error);
 }
 
 }  // namespace

@@ -58,16 +58,34 @@ void CountPixelOrigins(const RenderResult& result, ViewResult* r) {
 
 }  // namespace
 
+std::string FormatNumSources(int num_sources) {
+  return num_sources == 0 ? "auto" : std::to_string(num_sources);
+}
+
+int ParseNumSources(const std::string& text, const std::string& where) {
+  if (text == "auto") return 0;
+  size_t used = 0;
+  int k = 0;
+  try {
+    k = std::stoi(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  Require(used == text.size() && k >= 1, where,
+          "'" + text + "' is not a number of sources (a positive integer or auto)");
+  return k;
+}
+
 std::string EvalConfig::Label() const {
   std::string label =
-      method + " K=" + std::to_string(num_sources) + " s=" + FormatScale(scale);
+      method + " K=" + FormatNumSources(num_sources) + " s=" + FormatScale(scale);
   if (precision != "fp32") label += " " + precision;
   return label;
 }
 
 std::string EvalConfig::Slug() const {
   std::string slug =
-      method + "_k" + std::to_string(num_sources) + "_s" + FormatScale(scale);
+      method + "_k" + FormatNumSources(num_sources) + "_s" + FormatScale(scale);
   if (precision != "fp32") slug += "_" + precision;
   for (char& c : slug) {
     if (c == '.') c = 'p';

@@ -28,7 +28,7 @@ namespace fvs::eval {
 // One point of an evaluation (or of a sweep): method, K, resolution scale, precision.
 struct EvalConfig {
   std::string method = "ulr";
-  int num_sources = 5;
+  int num_sources = 5;  // 0 = adaptive (RenderOptions::num_sources)
   double scale = 1.0;
   // The renderer computes in float32 on the CPU; the column exists so that results of
   // other precisions (GPU fp16) merge into the same tables.
@@ -40,6 +40,11 @@ struct EvalConfig {
   // A file-name-safe form of Label(): "ulr_k5_s1".
   std::string Slug() const;
 };
+
+// K as the tables write it: the number, or "auto" for 0 (adaptive).
+std::string FormatNumSources(int num_sources);
+// The inverse; throws fvs::Error naming `where` for anything else.
+int ParseNumSources(const std::string& text, const std::string& where);
 
 constexpr double kNotAvailable = std::numeric_limits<double>::quiet_NaN();
 

@@ -73,6 +73,7 @@ Image PlotErrorAgainstTime(const std::vector<ConfigSummary>& summary,
     std::string name = p->config.method;
     if (p->config.scale != 1.0) name += Format(" scale %g", p->config.scale);
     if (p->config.precision != "fp32") name += " " + p->config.precision;
+    if (p->config.num_sources == 0) name += " adaptive K";  // a point of its own
     auto it = std::find_if(series.begin(), series.end(),
                            [&](const auto& s) { return s.first == name; });
     if (it == series.end()) {
@@ -177,7 +178,7 @@ Image PlotErrorAgainstTime(const std::vector<ConfigSummary>& summary,
                    kInk);
         DrawMarker(&image, px(p->Time(options.time)), py(p->psnr), Marker::kCircle, 7.0,
                    {1.0f, 1.0f, 1.0f});
-        const std::string k = "K" + std::to_string(p->config.num_sources);
+        const std::string k = "K" + FormatNumSources(p->config.num_sources);
         const int lx = static_cast<int>(px(p->Time(options.time))) + 9;
         const int ly = static_cast<int>(py(p->psnr)) - kGlyphHeight - 2;
         if (label_fits({lx - 1, ly - 1, lx + TextWidth(k) + 1, ly + kGlyphHeight + 1})) {

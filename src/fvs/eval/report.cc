@@ -181,9 +181,9 @@ void WriteResultsCsv(const std::string& path, const std::vector<ViewResult>& res
       char scale[32];
       std::snprintf(scale, sizeof(scale), "%g", r.config.scale);
       out << CsvField(r.scene) << "," << CsvField(r.config.method) << ","
-          << r.config.num_sources << "," << scale << "," << CsvField(r.config.precision)
-          << "," << CsvField(r.protocol) << "," << CsvField(r.target) << ","
-          << (r.geometry_holdout ? "yes" : "no") << ","
+          << FormatNumSources(r.config.num_sources) << "," << scale << ","
+          << CsvField(r.config.precision) << "," << CsvField(r.protocol) << ","
+          << CsvField(r.target) << "," << (r.geometry_holdout ? "yes" : "no") << ","
           << (r.ok()      ? "ok"
               : r.skipped ? "skipped"
                           : "error")
@@ -221,7 +221,7 @@ std::vector<ViewResult> ReadResultsCsv(const std::string& path) {
     ViewResult r;
     r.scene = fields[0];
     r.config.method = fields[1];
-    r.config.num_sources = ParseInt(fields[2], where);
+    r.config.num_sources = ParseNumSources(fields[2], where);
     r.config.scale = ParseNumber(fields[3], where);
     r.config.precision = fields[4];
     r.protocol = fields[5];
@@ -266,9 +266,9 @@ void WriteSummaryCsv(const std::string& path, const std::vector<ConfigSummary>& 
     for (const ConfigSummary& s : summary) {
       char scale[32];
       std::snprintf(scale, sizeof(scale), "%g", s.config.scale);
-      out << CsvField(s.config.method) << "," << s.config.num_sources << "," << scale
-          << "," << CsvField(s.config.precision) << "," << s.views_ok << ","
-          << s.views_failed << "," << FormatNumber(s.psnr, 4) << ","
+      out << CsvField(s.config.method) << "," << FormatNumSources(s.config.num_sources)
+          << "," << scale << "," << CsvField(s.config.precision) << "," << s.views_ok
+          << "," << s.views_failed << "," << FormatNumber(s.psnr, 4) << ","
           << FormatNumber(s.ssim, 5) << "," << FormatNumber(s.lpips, 5) << ","
           << FormatNumber(s.psnr_covered, 4) << "," << FormatNumber(s.ssim_covered, 5)
           << "," << FormatNumber(s.seconds, 4) << "," << FormatNumber(s.cpu_seconds, 4)
@@ -299,14 +299,15 @@ void WriteMarkdownReport(const std::string& path, const ReportContext& context,
     for (const ConfigSummary& s : summary) {
       char scale[32];
       std::snprintf(scale, sizeof(scale), "%g", s.config.scale);
-      out << "| " << cell(s.config.method) << " | " << s.config.num_sources << " | "
-          << scale << " | " << s.config.precision << " | " << s.views_ok << " | "
-          << s.views_failed << " | " << FormatNumber(s.psnr, 2) << " | "
-          << FormatNumber(s.ssim, 4) << " | " << FormatNumber(s.lpips, 4) << " | "
-          << FormatNumber(s.psnr_covered, 2) << " | " << FormatNumber(s.ssim_covered, 4)
-          << " | " << FormatNumber(s.seconds, 3) << " | "
-          << FormatNumber(s.cpu_seconds, 3) << " | " << FormatNumber(s.sources_used, 1)
-          << " | " << (s.pareto ? "yes" : "") << " |\n";
+      out << "| " << cell(s.config.method) << " | "
+          << FormatNumSources(s.config.num_sources) << " | " << scale << " | "
+          << s.config.precision << " | " << s.views_ok << " | " << s.views_failed << " | "
+          << FormatNumber(s.psnr, 2) << " | " << FormatNumber(s.ssim, 4) << " | "
+          << FormatNumber(s.lpips, 4) << " | " << FormatNumber(s.psnr_covered, 2) << " | "
+          << FormatNumber(s.ssim_covered, 4) << " | " << FormatNumber(s.seconds, 3)
+          << " | " << FormatNumber(s.cpu_seconds, 3) << " | "
+          << FormatNumber(s.sources_used, 1) << " | " << (s.pareto ? "yes" : "")
+          << " |\n";
     }
     out << "\n## Per view\n\n";
     out << "| configuration | target | held out of the mesh | PSNR | SSIM | LPIPS | "

@@ -64,7 +64,9 @@ std::vector<double> ParseDoubleList(const std::string& list, const std::string& 
 
 void SweepOptions::Check() const {
   Require(!Items(methods).empty(), "--sweep_methods", "empty list");
-  ParseIntList(num_sources, "--sweep_num_sources");
+  for (const std::string& k : Items(num_sources))
+    ParseNumSources(k, "--sweep_num_sources");
+  Require(!Items(num_sources).empty(), "--sweep_num_sources", "empty list");
   ParseDoubleList(scales, "--sweep_scales");
   for (const std::string& p : Items(precisions)) {
     Require(KnownPrecision(p), "--sweep_precisions",
@@ -87,7 +89,10 @@ SweepPlan PlanSweep(const SweepOptions& options) {
   for (const std::string& path : Items(options.model_paths)) {
     weights.emplace(WeightsVariant(path), path);
   }
-  const std::vector<int> ks = ParseIntList(options.num_sources, "--sweep_num_sources");
+  std::vector<int> ks;  // 0 = adaptive
+  for (const std::string& k : Items(options.num_sources)) {
+    ks.push_back(ParseNumSources(k, "--sweep_num_sources"));
+  }
   const std::vector<double> scales = ParseDoubleList(options.scales, "--sweep_scales");
   for (const std::string& method : Items(options.methods)) {
     std::string model_path;

@@ -162,6 +162,7 @@ std::string RenderSettings(const ViewSynthesisOptions& o) {
   }
   json["workspace_hash"] = WorkspaceHash(o.workspace_path);
   json["num_sources"] = o.render.num_sources;
+  if (o.render.num_sources == 0) json["max_num_sources"] = o.render.max_num_sources;
   json["selection_tolerance"] = o.render.selection_tolerance;
   json["warp_tolerance"] = o.render.warp_tolerance;
   json["width"] = o.width;
@@ -245,7 +246,10 @@ int RunViewSynthesis(int argc, char** argv) {
   options.AddDefault("method", &o.method, "ulr, nearest or fvs (needs --model_path)");
   options.AddDefault("model_path", &o.render.model_path,
                      "network weights (--method fvs)");
-  options.AddDefault("num_sources", &o.render.num_sources, "K sources per target");
+  options.AddDefault("num_sources", &o.render.num_sources,
+                     "K sources per target; 0 = adaptive, up to --max_num_sources");
+  options.AddDefault("max_num_sources", &o.render.max_num_sources,
+                     "the most sources an adaptive K (0) takes");
   options.AddDefault("selection_tolerance", &o.render.selection_tolerance,
                      "relative depth tolerance for ranking sources");
   options.AddDefault("warp_tolerance", &o.render.warp_tolerance,

@@ -53,13 +53,16 @@ struct EvalCommandOptions {
   int thumbnail_width = 320;
   bool write_images = false;
   int num_threads = 0;
+  int max_num_sources = RenderOptions().max_num_sources;
   bool fill_holes = true;
   std::string device = "auto";
 
   void Check() const {
     protocol.Check();
     Shard::Parse(shard);
-    Require(config.num_sources >= 1, "--num_sources", "must be at least 1");
+    Require(config.num_sources >= 0, "--num_sources",
+            "must be at least 1, or 0 (adaptive)");
+    Require(max_num_sources >= 1, "--max_num_sources", "must be at least 1");
     Require(config.scale > 0 && config.scale <= 4, "--scale", "must be in (0, 4]");
     ParseTimeMeasure(time);
     Require(thumbnail_width >= 0, "--thumbnail_width", "must not be negative");
@@ -114,14 +117,18 @@ int RunViewSynthesisEval(int argc, char** argv) {
       "method", &o.config.method,
       "ulr, nearest, fvs or a variant (fvs_fast, ...; needs --model_path)");
   options.AddDefault("model_path", &o.config.model_path, "network weights");
-  options.AddDefault("num_sources", &o.config.num_sources, "K sources per target");
+  options.AddDefault("num_sources", &o.config.num_sources,
+                     "K sources per target; 0 = adaptive, up to --max_num_sources");
+  options.AddDefault("max_num_sources", &o.max_num_sources,
+                     "the most sources an adaptive K (0, auto) takes");
   options.AddDefault("scale", &o.config.scale,
                      "render at this fraction of the photo size (upsampled to score)");
   options.AddDefault("sweep", &o.sweep,
                      "render every configuration of the --sweep_* lists: Pareto table "
                      "and plot of quality against seconds per view");
   options.AddDefault("sweep_methods", &o.sweep_options.methods, "methods to sweep");
-  options.AddDefault("sweep_num_sources", &o.sweep_options.num_sources, "K values");
+  options.AddDefault("sweep_num_sources", &o.sweep_options.num_sources,
+                     "K values (auto: adaptive)");
   options.AddDefault("sweep_scales", &o.sweep_options.scales, "resolution scales");
   options.AddDefault("precision", &o.config.precision,
                      "network methods: fp32, bf16, or fp16 (CUDA only)");
@@ -160,6 +167,7 @@ int RunViewSynthesisEval(int argc, char** argv) {
   std::vector<std::string> notes;
   EvalRunOptions run;
   run.render.num_threads = o.num_threads;
+  run.render.max_num_sources = o.max_num_sources;
   run.render.fill_holes = o.fill_holes;
   run.render.device = o.device;
   run.render.scene_model_dir = WorkspaceFinetunedModelDir(o.workspace_path);

@@ -19,7 +19,8 @@ bool KnownPrecision(const std::string& name) {
 }
 
 void RenderOptions::Check() const {
-  Require(num_sources >= 1, "--num_sources", "must be at least 1");
+  Require(num_sources >= 0, "--num_sources", "must be at least 1, or 0 (adaptive)");
+  Require(max_num_sources >= 1, "--max_num_sources", "must be at least 1");
   Require(selection_tolerance > 0 && std::isfinite(selection_tolerance),
           "--selection_tolerance", "must be positive");
   Require(warp_tolerance > 0 && std::isfinite(warp_tolerance), "--warp_tolerance",

@@ -34,7 +34,11 @@ struct TargetView {
 bool KnownPrecision(const std::string& name);
 
 struct RenderOptions {
-  int num_sources = 5;                // K
+  // K sources per target; 0 = adaptive: per target, sources are taken in order of
+  // overlap while they add coverage, at most max_num_sources
+  // (scene/source_selection.h).
+  int num_sources = 5;
+  int max_num_sources = 10;
   double selection_tolerance = 0.10;  // relative depth tolerance for ranking sources
   double warp_tolerance = 0.01;       // relative occlusion tolerance when warping
   int selection_stride = 1;           // test every n-th target pixel when ranking

@@ -38,20 +38,24 @@ PreparedTarget PrepareTarget(const Scene& scene, const TargetView& target,
 
   timer.Restart();
   SourceSelectionOptions selection;
-  selection.k = options.num_sources;
+  selection.adaptive = options.num_sources == 0;
+  selection.k = selection.adaptive ? options.max_num_sources : options.num_sources;
   selection.depth_tolerance = options.selection_tolerance;
   selection.exclude = target.exclude_views;
   selection.stride = options.selection_stride;
   selection.num_threads = options.num_threads;
+  const SourceRanking ranking =
+      RankSources(scene, target.camera, prepared.depth, selection);
   const bool hysteresis =
       options.source_hysteresis > 0 && !target.preferred_sources.empty();
-  if (hysteresis) selection.k = std::max(1, scene.num_views());  // rank every source
-  prepared.sources = SelectSources(scene, target.camera, prepared.depth, selection);
-  if (hysteresis) {
-    prepared.sources =
-        ApplySourceHysteresis(prepared.sources, target.preferred_sources,
-                              options.source_hysteresis, options.num_sources);
-  }
+  // The hysteresis reorders the ranking; the choice (top K or adaptive) follows it.
+  prepared.sources = ChooseSources(
+      ranking,
+      hysteresis ? ApplySourceHysteresis(ranking.ranked, target.preferred_sources,
+                                         options.source_hysteresis,
+                                         static_cast<int>(ranking.ranked.size()))
+                 : ranking.ranked,
+      selection);
   if (options.stable_source_order) {
     std::sort(prepared.sources.begin(), prepared.sources.end(),
               [](const SourceScore& a, const SourceScore& b) {
