@@ -13,7 +13,7 @@ namespace fvs::ui {
 
 struct RenderRequest {
   std::string method = "ulr";
-  int num_sources = 5;
+  int num_sources = 0;  // 0 = auto (RenderOptions::num_sources)
   int width = 640;
   int height = 480;
   std::string model_path;  // weights, for the fvs methods

@@ -80,7 +80,9 @@ TEST(RenderTest, HeldOutViewMatchesGroundTruth) {
     view.camera = scene.view(held_out).camera;
     view.exclude_views = {held_out};
     const Image truth = scene.SourceImage(held_out);
-    const RenderResult ulr = RenderWith("ulr", scene, view);
+    RenderOptions five;  // a fixed K (the default is adaptive)
+    five.num_sources = 5;
+    const RenderResult ulr = RenderWith("ulr", scene, view, five);
     const RenderResult nearest = RenderWith("nearest", scene, view);
     ExpectFiniteResult(ulr);
     ExpectFiniteResult(nearest);
@@ -104,7 +106,7 @@ TEST(RenderTest, HeldOutViewMatchesGroundTruth) {
     EXPECT_GT(covered / (w * h), 0.97);
     // Without the filling the holes are black; with it they are the only pixels that
     // change, and their confidence stays 0.
-    RenderOptions raw;
+    RenderOptions raw = five;
     raw.fill_holes = false;
     const RenderResult black = RenderWith("ulr", scene, view, raw);
     int holes = 0;

@@ -28,7 +28,7 @@ namespace fvs::eval {
 // One point of an evaluation (or of a sweep): method, K, resolution scale, precision.
 struct EvalConfig {
   std::string method = "ulr";
-  int num_sources = 5;  // 0 = adaptive (RenderOptions::num_sources)
+  int num_sources = 0;  // 0 = adaptive (RenderOptions::num_sources)
   double scale = 1.0;
   // The renderer computes in float32 on the CPU; the column exists so that results of
   // other precisions (GPU fp16) merge into the same tables.

@@ -16,7 +16,7 @@ struct SweepOptions {
   std::string methods =
       "nearest,ulr,fvs,fvs_nogru,fvs_nomasks,fvs_noinfdepth,"
       "fvs_single,fvs_fast";
-  std::string num_sources = "1,2,3,4,5,6,7,8";  // "auto": adaptive K
+  std::string num_sources = "1,2,3,4,5,6,7,8,auto";  // "auto": adaptive K
   std::string scales = "1,0.5,0.25";
   std::string precisions = "fp32";
   std::string model_paths;  // comma-separated weight files (any variants)

@@ -34,10 +34,10 @@ struct TargetView {
 bool KnownPrecision(const std::string& name);
 
 struct RenderOptions {
-  // K sources per target; 0 = adaptive: per target, sources are taken in order of
-  // overlap while they add coverage, at most max_num_sources
-  // (scene/source_selection.h).
-  int num_sources = 5;
+  // K sources per target; 0 (the default) = adaptive: per target, sources are taken in
+  // order of overlap while they add coverage, at most max_num_sources
+  // (scene/source_selection.h; doc/evaluation.md compares it with fixed K).
+  int num_sources = 0;
   int max_num_sources = 10;
   double selection_tolerance = 0.10;  // relative depth tolerance for ranking sources
   double warp_tolerance = 0.01;       // relative occlusion tolerance when warping

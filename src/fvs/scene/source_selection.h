@@ -38,10 +38,13 @@ struct SourceScore {
 struct SourceSelectionOptions {
   int k = 5;  // the number of sources; with adaptive, the most
   bool adaptive = false;
-  // The adaptive rule (see the top of this file).
+  // The adaptive rule (see the top of this file). Defaults chosen on leave-one-out views
+  // of three training scenes (doc/evaluation.md, adaptive K): a source is worth adding
+  // for pixels no source sees yet; asking for more views per pixel added sources that
+  // blurred the blend.
   int min_k = 2;
-  int wanted_views = 3;
-  double min_gain = 0.01;  // fraction of the target's pixels
+  int wanted_views = 1;
+  double min_gain = 0.005;  // fraction of the target's pixels
   double depth_tolerance = 0.1;
   // Views never selected (e.g. the held-out target itself in an evaluation).
   std::vector<int> exclude;
