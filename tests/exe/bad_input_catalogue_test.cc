@@ -46,14 +46,17 @@ struct BadInputCase {
   std::string args;
   std::string file;
   std::vector<std::string> fault;
-  int file_size_limit_kb = -1;  // >= 0: run under `ulimit -f` (a full disk)
+  // >= 0: run under `ulimit -f` this many blocks (a full disk); /bin/sh counts 512-byte
+  // blocks.
+  int file_size_limit_blocks = -1;
 };
 
 // --- Ways to break a file -------------------------------------------------------------
 
 void Truncate(const std::string& path, uintmax_t size) { fs::resize_file(path, size); }
 
-void PatchBytes(const std::string& path, std::streamoff offset, const std::string& bytes) {
+void PatchBytes(const std::string& path, std::streamoff offset,
+                const std::string& bytes) {
   std::fstream f(path, std::ios::binary | std::ios::in | std::ios::out);
   f.seekp(offset);
   f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
@@ -170,52 +173,76 @@ std::vector<BadInputCase> Catalogue() {
       // view_synthesis: the workspace.
       {"cameras_bin_truncated",
        [](const std::string& d) { Truncate(d + "/W/sparse/cameras.bin", 20); },
-       interpolate, "W/sparse/cameras.bin", {"truncated"}},
+       interpolate,
+       "W/sparse/cameras.bin",
+       {"truncated"}},
       {"unknown_camera_model",
        [=](const std::string& d) {
          PatchBytes(d + "/W/sparse/cameras.bin", camera_model, std::string("\x63", 1));
        },
-       interpolate, "W/sparse/cameras.bin", {"unknown camera model id 99"}},
+       interpolate,
+       "W/sparse/cameras.bin",
+       {"unknown camera model id 99"}},
       {"images_bin_wrong_count",
        [](const std::string& d) {
          PatchBytes(d + "/W/sparse/images.bin", 0, std::string("\xff\xff\xff\xff", 4));
        },
-       interpolate, "W/sparse/images.bin", {"number of images is 4294967295", "truncated"}},
+       interpolate,
+       "W/sparse/images.bin",
+       {"number of images is 4294967295", "truncated"}},
       {"pose_nan",
        [=](const std::string& d) {
          PatchBytes(d + "/W/sparse/images.bin", qvec_w, DoubleBytes(std::nan("")));
        },
-       interpolate, "W/sparse/images.bin", {"frame_0000.png", "non-finite pose"}},
+       interpolate,
+       "W/sparse/images.bin",
+       {"frame_0000.png", "non-finite pose"}},
       {"pose_inf",
        [=](const std::string& d) {
          PatchBytes(d + "/W/sparse/images.bin", tvec_x, DoubleBytes(HUGE_VAL));
        },
-       interpolate, "W/sparse/images.bin", {"non-finite pose"}},
+       interpolate,
+       "W/sparse/images.bin",
+       {"non-finite pose"}},
       {"points3d_bin_truncated",
        [](const std::string& d) { Truncate(d + "/W/sparse/points3D.bin", 10); },
-       interpolate, "W/sparse/points3D.bin", {"truncated"}},
+       interpolate,
+       "W/sparse/points3D.bin",
+       {"truncated"}},
       {"sparse_model_empty",
        [](const std::string& d) {
          for (const char* f : {"cameras.bin", "images.bin", "points3D.bin"}) {
            fs::remove(d + "/W/sparse/" + f);
          }
        },
-       interpolate, "W/sparse", {"no sparse model"}},
+       interpolate,
+       "W/sparse",
+       {"no sparse model"}},
       {"mesh_wrong_magic",
        [](const std::string& d) { PatchBytes(d + "/W/meshed-delaunay.ply", 0, "plx"); },
-       interpolate, "W/meshed-delaunay.ply", {"not a PLY file", "wrong magic"}},
+       interpolate,
+       "W/meshed-delaunay.ply",
+       {"not a PLY file", "wrong magic"}},
       {"mesh_truncated",
        [](const std::string& d) { Truncate(d + "/W/meshed-delaunay.ply", 300); },
-       interpolate, "W/meshed-delaunay.ply", {"truncated"}},
+       interpolate,
+       "W/meshed-delaunay.ply",
+       {"truncated"}},
       {"photo_missing",
        [](const std::string& d) { fs::remove(d + "/W/images/frame_0001.png"); },
-       interpolate, "W/images/frame_0001.png", {"cannot read image"}},
+       interpolate,
+       "W/images/frame_0001.png",
+       {"cannot read image"}},
       {"photo_zero_sized",
        [](const std::string& d) { Truncate(d + "/W/images/frame_0002.png", 0); },
-       interpolate, "W/images/frame_0002.png", {"cannot read image"}},
+       interpolate,
+       "W/images/frame_0002.png",
+       {"cannot read image"}},
       {"photo_wrong_size",
        [](const std::string& d) { WriteSmallPng(d + "/W/images/frame_0003.png"); },
-       interpolate, "W/images/frame_0003.png", {"image is 10x10 but its camera is 64x48"}},
+       interpolate,
+       "W/images/frame_0003.png",
+       {"image is 10x10 but its camera is 64x48"}},
       // view_synthesis: camera paths, weights, ground truth, output.
       {"camera_path_no_frames",
        [](const std::string& d) {
@@ -224,17 +251,23 @@ std::vector<BadInputCase> Catalogue() {
            j["keyframes"] = nlohmann::json::array();
          });
        },
-       vs + " --camera_path path.json", "path.json", {"camera_path is empty"}},
+       vs + " --camera_path path.json",
+       "path.json",
+       {"camera_path is empty"}},
       {"camera_path_matrix_wrong_size",
        [](const std::string& d) {
          EditJson(d + "/path.json", [](nlohmann::json& j) {
            j["camera_path"][0]["camera_to_world"].erase(0);
          });
        },
-       vs + " --camera_path path.json", "path.json", {"16 (or 12) numbers"}},
+       vs + " --camera_path path.json",
+       "path.json",
+       {"16 (or 12) numbers"}},
       {"camera_path_truncated",
        [](const std::string& d) { Truncate(d + "/path.json", 200); },
-       vs + " --camera_path path.json", "path.json", {"not valid JSON"}},
+       vs + " --camera_path path.json",
+       "path.json",
+       {"not valid JSON"}},
       {"camera_path_infinite_pose",
        [](const std::string& d) {
          // JSON has no NaN or Inf: a number past double's range is how one arrives.
@@ -243,30 +276,45 @@ std::vector<BadInputCase> Catalogue() {
          text.insert(at, "1e999, ");
          WriteTextFile(d + "/path.json", text);
        },
-       vs + " --camera_path path.json", "path.json", {"number overflow"}},
-      {"weights_missing", no_setup,
-       interpolate + " --method fvs --model_path nosuch.safetensors", "nosuch.safetensors",
+       vs + " --camera_path path.json",
+       "path.json",
+       {"number overflow"}},
+      {"weights_missing",
+       no_setup,
+       interpolate + " --method fvs --model_path nosuch.safetensors",
+       "nosuch.safetensors",
        {"cannot open"}},
       {"weights_mismatched",
-       [](const std::string& d) { WriteMismatchedWeights(d + "/w.safetensors", "fvs_fast"); },
-       interpolate + " --method fvs --model_path w.safetensors", "w.safetensors",
+       [](const std::string& d) {
+         WriteMismatchedWeights(d + "/w.safetensors", "fvs_fast");
+       },
+       interpolate + " --method fvs --model_path w.safetensors",
+       "w.safetensors",
        {"weights do not match network variant 'fvs_fast'", "missing"}},
       {"weights_truncated",
        [](const std::string& d) {
          WriteMismatchedWeights(d + "/w.safetensors", "fvs_fast");
          Truncate(d + "/w.safetensors", 20);
        },
-       interpolate + " --method fvs --model_path w.safetensors", "w.safetensors",
+       interpolate + " --method fvs --model_path w.safetensors",
+       "w.safetensors",
        {"truncated"}},
       {"ground_truth_wrong_size",
        [](const std::string& d) { WriteSmallPng(d + "/G/frame_00000.png"); },
-       interpolate + " --ground_truth_path G", "G/frame_00000.png",
+       interpolate + " --ground_truth_path G",
+       "G/frame_00000.png",
        {"ground truth of 10x10 for a frame of 64x48"}},
-      {"output_folder_uncreatable", MakeBlockingFile,
-       "view_synthesis --workspace_path W --output_path F/O --interpolate 1", "F/O",
+      {"output_folder_uncreatable",
+       MakeBlockingFile,
+       "view_synthesis --workspace_path W --output_path F/O --interpolate 1",
+       "F/O",
        {"cannot create the output folder", "Not a directory"}},
-      {"disk_full_render", no_setup, interpolate, "O/render_settings.json",
-       {"write failed"}, 0},
+      {"disk_full_render",
+       no_setup,
+       interpolate,
+       "O/render_settings.json",
+       {"write failed"},
+       0},
       // view_synthesis_path.
       {"path_no_keyframes",
        [](const std::string& d) {
@@ -277,124 +325,180 @@ std::vector<BadInputCase> Catalogue() {
        },
        "view_synthesis_path --workspace_path W --output_path P/out.json"
        " --keyframes_path path.json",
-       "path.json", {"empty"}},
-      {"path_unknown_keyframe", no_setup,
+       "path.json",
+       {"empty"}},
+      {"path_unknown_keyframe",
+       no_setup,
        "view_synthesis_path --workspace_path W --output_path P/out.json"
        " --keyframes frame_0000.png,nosuch.png",
-       "nosuch.png", {"not a registered image"}},
-      {"path_disk_full", no_setup,
-       "view_synthesis_path --workspace_path W --output_path P/out.json", "P/out.json",
-       {"write failed"}, 0},
-      {"path_output_uncreatable", MakeBlockingFile,
-       "view_synthesis_path --workspace_path W --output_path F/P/out.json", "F/P",
+       "nosuch.png",
+       {"not a registered image"}},
+      {"path_disk_full",
+       no_setup,
+       "view_synthesis_path --workspace_path W --output_path P/out.json",
+       "P/out.json",
+       {"write failed"},
+       0},
+      {"path_output_uncreatable",
+       MakeBlockingFile,
+       "view_synthesis_path --workspace_path W --output_path F/P/out.json",
+       "F/P",
        {"cannot create the folder"}},
       // view_synthesis_pack.
-      {"pack_disk_full", no_setup,
+      {"pack_disk_full",
+       no_setup,
        "view_synthesis_pack --workspace_path W --output_path T2 --scale 1",
-       "T2/scene.safetensors", {"write failed"}, 16},
-      {"pack_output_uncreatable", MakeBlockingFile,
-       "view_synthesis_pack --workspace_path W --output_path F/T2 --scale 1", "F/T2",
+       "T2/scene.safetensors",
+       {"write failed"},
+       16},  // 8 KiB of the 87 KiB written
+      {"pack_output_uncreatable",
+       MakeBlockingFile,
+       "view_synthesis_pack --workspace_path W --output_path F/T2 --scale 1",
+       "F/T2",
        {"cannot create the output folder"}},
       // view_synthesis_eval.
       {"eval_weights_mismatched",
-       [](const std::string& d) { WriteMismatchedWeights(d + "/w.safetensors", "fvs_fast"); },
+       [](const std::string& d) {
+         WriteMismatchedWeights(d + "/w.safetensors", "fvs_fast");
+       },
        "view_synthesis_eval --workspace_path W --output_path E2 --method fvs"
        " --model_path w.safetensors",
-       "w.safetensors", {"weights do not match"}},
+       "w.safetensors",
+       {"weights do not match"}},
       {"eval_cameras_bin_truncated",
        [](const std::string& d) { Truncate(d + "/W/sparse/cameras.bin", 20); },
-       "view_synthesis_eval --workspace_path W --output_path E2", "W/sparse/cameras.bin",
+       "view_synthesis_eval --workspace_path W --output_path E2",
+       "W/sparse/cameras.bin",
        {"truncated"}},
-      {"eval_output_uncreatable", MakeBlockingFile,
-       "view_synthesis_eval --workspace_path W --output_path F/E2", "F/E2",
+      {"eval_output_uncreatable",
+       MakeBlockingFile,
+       "view_synthesis_eval --workspace_path W --output_path F/E2",
+       "F/E2",
        {"cannot create the output folder"}},
       // view_synthesis_eval_merge.
       {"merge_folder_without_results",
        [](const std::string& d) { fs::create_directories(d + "/X"); },
-       "view_synthesis_eval_merge --input_paths E,X --output_path M", "X",
+       "view_synthesis_eval_merge --input_paths E,X --output_path M",
+       "X",
        {"no results.csv"}},
       {"merge_results_truncated",
        [](const std::string& d) { Truncate(d + "/E/results.csv", 250); },
-       "view_synthesis_eval_merge --input_paths E --output_path M", "E/results.csv:2",
+       "view_synthesis_eval_merge --input_paths E --output_path M",
+       "E/results.csv:2",
        {"fields, expected"}},
       {"merge_contact_sheet_wrong_magic",
        [](const std::string& d) { WriteTextFile(d + "/E/contact_sheet.png", "garbage"); },
-       "view_synthesis_eval_merge --input_paths E --output_path M", "E/contact_sheet.png",
+       "view_synthesis_eval_merge --input_paths E --output_path M",
+       "E/contact_sheet.png",
        {"cannot read image"}},
-      {"merge_overlapping_shards", no_setup,
-       "view_synthesis_eval_merge --input_paths E,E --output_path M", "E/results.csv",
+      {"merge_overlapping_shards",
+       no_setup,
+       "view_synthesis_eval_merge --input_paths E,E --output_path M",
+       "E/results.csv",
        {"overlapping shards"}},
-      {"merge_disk_full", no_setup,
-       "view_synthesis_eval_merge --input_paths E --output_path M", "M/results.csv",
-       {"write failed"}, 0},
+      {"merge_disk_full",
+       no_setup,
+       "view_synthesis_eval_merge --input_paths E --output_path M",
+       "M/results.csv",
+       {"write failed"},
+       0},
       // view_synthesis_train.
       {"train_scene_missing",
        [](const std::string& d) { WriteTextFile(d + "/list.txt", d + "/nosuch\n"); },
-       train, "list.txt", {"does not exist"}},
+       train,
+       "list.txt",
+       {"does not exist"}},
       {"train_scene_list_empty",
-       [](const std::string& d) { WriteTextFile(d + "/list.txt", ""); }, train,
-       "list.txt", {"names no scene"}},
+       [](const std::string& d) { WriteTextFile(d + "/list.txt", ""); },
+       train,
+       "list.txt",
+       {"names no scene"}},
       {"train_pack_truncated",
-       [](const std::string& d) { Truncate(d + "/T/scene.safetensors", 5000); }, train,
-       "T/scene.safetensors", {"truncated"}},
+       [](const std::string& d) { Truncate(d + "/T/scene.safetensors", 5000); },
+       train,
+       "T/scene.safetensors",
+       {"truncated"}},
       {"train_pack_wrong_magic",
-       [](const std::string& d) { WriteTextFile(d + "/T/scene.safetensors", "garbage!!"); },
-       train, "T/scene.safetensors", {"not a safetensors file"}},
+       [](const std::string& d) {
+         WriteTextFile(d + "/T/scene.safetensors", "garbage!!");
+       },
+       train,
+       "T/scene.safetensors",
+       {"not a safetensors file"}},
       {"train_init_weights_mismatched",
-       [](const std::string& d) { WriteMismatchedWeights(d + "/w.safetensors", "fvs_fast"); },
-       train + " --Train.init_weights w.safetensors", "w.safetensors",
+       [](const std::string& d) {
+         WriteMismatchedWeights(d + "/w.safetensors", "fvs_fast");
+       },
+       train + " --Train.init_weights w.safetensors",
+       "w.safetensors",
        {"weights do not match"}},
       // view_synthesis_finetune: nothing may be written into W before the weights load.
-      {"finetune_weights_missing", no_setup,
+      {"finetune_weights_missing",
+       no_setup,
        "view_synthesis_finetune --workspace_path W --minutes 0.1"
        " --model_path nosuch.safetensors",
-       "nosuch.safetensors", {"cannot open"}},
+       "nosuch.safetensors",
+       {"cannot open"}},
       {"finetune_weights_mismatched",
-       [](const std::string& d) { WriteMismatchedWeights(d + "/w.safetensors", "fvs_fast"); },
+       [](const std::string& d) {
+         WriteMismatchedWeights(d + "/w.safetensors", "fvs_fast");
+       },
        "view_synthesis_finetune --workspace_path W --minutes 0.1 --method fvs_fast"
        " --model_path w.safetensors",
-       "w.safetensors", {"weights do not match"}},
+       "w.safetensors",
+       {"weights do not match"}},
       // view_synthesis_model_info.
       {"model_info_weights_without_config",
        [](const std::string& d) { WriteMismatchedWeights(d + "/w.safetensors", ""); },
-       "view_synthesis_model_info --weights w.safetensors --time 0", "w.safetensors",
+       "view_synthesis_model_info --weights w.safetensors --time 0",
+       "w.safetensors",
        {"no network config"}},
       // view_synthesis_mesher.
-      {"mesher_fused_missing", no_setup,
-       "view_synthesis_mesher --workspace_path W --output_path W/out.ply", "W/fused.ply",
+      {"mesher_fused_missing",
+       no_setup,
+       "view_synthesis_mesher --workspace_path W --output_path W/out.ply",
+       "W/fused.ply",
        {"missing"}},
       {"mesher_fused_wrong_magic",
        [](const std::string& d) {
          WriteTextFile(d + "/W/fused.ply", "garbage\n");
          WriteTextFile(d + "/W/fused.ply.vis", "x");
        },
-       "view_synthesis_mesher --workspace_path W --output_path W/out.ply", "W/fused.ply",
+       "view_synthesis_mesher --workspace_path W --output_path W/out.ply",
+       "W/fused.ply",
        {"not a PLY file"}},
-      // view_synthesis_stereo: the default configs are not written for a broken workspace.
+      // view_synthesis_stereo: the default configs are not written for a broken
+      // workspace.
       {"stereo_photo_missing",
        [](const std::string& d) { fs::remove(d + "/W/images/frame_0001.png"); },
-       "view_synthesis_stereo --workspace_path W", "W/images/frame_0001.png",
+       "view_synthesis_stereo --workspace_path W",
+       "W/images/frame_0001.png",
        {"image file is missing"}},
       {"stereo_config_unknown_image",
        [](const std::string& d) {
          fs::create_directories(d + "/W/stereo");
          WriteTextFile(d + "/W/stereo/patch-match.cfg", "nosuch.png\n__auto__, 3\n");
        },
-       "view_synthesis_stereo --workspace_path W", "W/stereo/patch-match.cfg",
+       "view_synthesis_stereo --workspace_path W",
+       "W/stereo/patch-match.cfg",
        {"'nosuch.png' is not in the sparse model"}},
       // view_synthesis_depth_cache.
       {"depth_cache_mesh_truncated",
        [](const std::string& d) { Truncate(d + "/W/meshed-delaunay.ply", 300); },
-       "view_synthesis_depth_cache --workspace_path W", "W/meshed-delaunay.ply",
+       "view_synthesis_depth_cache --workspace_path W",
+       "W/meshed-delaunay.ply",
        {"truncated"}},
       {"depth_cache_disk_full",
        [](const std::string& d) { fs::remove_all(d + "/W/fvs/depth"); },
-       "view_synthesis_depth_cache --workspace_path W", "W/fvs/depth/", {"write failed"},
+       "view_synthesis_depth_cache --workspace_path W",
+       "W/fvs/depth/",
+       {"write failed"},
        0},
       // view_synthesis_prepare: photo folders.
       {"prepare_empty_folder",
        [](const std::string& d) { fs::create_directories(d + "/P"); },
-       "view_synthesis_prepare --image_path P --workspace_path WS", "P",
+       "view_synthesis_prepare --image_path P --workspace_path WS",
+       "P",
        {"no images"}},
       {"prepare_zero_sized_photos",
        [](const std::string& d) {
@@ -403,19 +507,22 @@ std::vector<BadInputCase> Catalogue() {
            WriteTextFile(d + "/P/" + f, "");
          }
        },
-       "view_synthesis_prepare --image_path P --workspace_path WS", "P/a.png",
+       "view_synthesis_prepare --image_path P --workspace_path WS",
+       "P/a.png",
        {"cannot read image"}},
-      {"prepare_workspace_uncreatable", MakeBlockingFile,
-       "view_synthesis_prepare --image_path W/images --workspace_path F/WS", "F/WS",
+      {"prepare_workspace_uncreatable",
+       MakeBlockingFile,
+       "view_synthesis_prepare --image_path W/images --workspace_path F/WS",
+       "F/WS",
        {"cannot create"}},
       // view_synthesis_synthetic: ground truth of a camera path.
       {"synthetic_camera_path_no_frames",
        [](const std::string& d) {
-         EditJson(d + "/path.json", [](nlohmann::json& j) {
-           j["camera_path"] = nlohmann::json::array();
-         });
+         EditJson(d + "/path.json",
+                  [](nlohmann::json& j) { j["camera_path"] = nlohmann::json::array(); });
        },
-       "view_synthesis_synthetic --output_path S --camera_path path.json", "path.json",
+       "view_synthesis_synthetic --output_path S --camera_path path.json",
+       "path.json",
        {"camera_path is empty"}},
   };
 }
@@ -452,10 +559,10 @@ CaseResult RunCase(const BadInputCase& c, const std::string& fixture,
   // stderr through the pipe, not into a file: under `ulimit -f 0` a file could not take
   // the error line. In a subshell, since RunShell appends 2>&1 to the command line.
   std::string command = "(cd '" + dir + "' && ";
-  if (c.file_size_limit_kb >= 0) {
-    command += "ulimit -f " + std::to_string(c.file_size_limit_kb) + " && ";
+  if (c.file_size_limit_blocks >= 0) {
+    command += "ulimit -f " + std::to_string(c.file_size_limit_blocks) + " && ";
   }
-  // exec: a child killed by a signal shows as one (RunShell's -1), not as 128 + n.
+  // A child killed by a signal (an abort, SIGXFSZ) exits as 128 + n: not the 1 expected.
   command += "exec env FVS_QUIET=1 OMP_WAIT_POLICY=PASSIVE QT_QPA_PLATFORM=offscreen '" +
              FrontDoorBinary() + "' " + c.args + " 2>&1 >/dev/null)";
   const auto start = std::chrono::steady_clock::now();
@@ -498,8 +605,7 @@ TEST_F(BadInputCatalogue, EveryCaseIsOneErrorLineNamingTheFileAndLeavesNoOutput)
     const CaseResult& r = results[i];
     // The catalogue as run (doc/reliability.md): case | command | seconds | stderr.
     std::printf("| %s | `colmap %s` | %.1f | `%s` |\n", c.name.c_str(), c.args.c_str(),
-                r.seconds,
-                r.stderr_text.substr(0, r.stderr_text.find('\n')).c_str());
+                r.seconds, r.stderr_text.substr(0, r.stderr_text.find('\n')).c_str());
     SCOPED_TRACE("case " + c.name + ": colmap " + c.args + " (" +
                  std::to_string(r.seconds) + " s)");
     ASSERT_TRUE(r.setup_error.empty()) << r.setup_error;
@@ -510,9 +616,11 @@ TEST_F(BadInputCatalogue, EveryCaseIsOneErrorLineNamingTheFileAndLeavesNoOutput)
         << "stderr is not exactly one line:\n"
         << e;
     EXPECT_EQ(e.rfind("ERROR: ", 0), 0u) << e;
-    EXPECT_NE(e.find(c.file), std::string::npos) << "does not name " << c.file << ": " << e;
+    EXPECT_NE(e.find(c.file), std::string::npos)
+        << "does not name " << c.file << ": " << e;
     for (const std::string& words : c.fault) {
-      EXPECT_NE(e.find(words), std::string::npos) << "does not say " << words << ": " << e;
+      EXPECT_NE(e.find(words), std::string::npos)
+          << "does not say " << words << ": " << e;
     }
     std::string changes;
     for (const std::string& change : r.changes) changes += "  " + change + "\n";
