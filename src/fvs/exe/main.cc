@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
@@ -49,6 +50,12 @@ int PrintHelp(const std::string& real_colmap, const std::string& help_arg) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Past a file-size limit (ulimit -f) the kernel sends SIGXFSZ, whose default action
+  // kills the process without a word and leaves the temporary file of the write behind.
+  // Ignored, the write fails with EFBIG instead and the writer reports it as one error
+  // line and removes its temporary file. The real COLMAP, exec'd below, gets the
+  // default back.
+  std::signal(SIGXFSZ, SIG_IGN);
   const std::string command = argc >= 2 ? argv[1] : "";
   if (fvs::FindCommand(command) != nullptr) return fvs::RunCommand(argc, argv);
 
@@ -70,6 +77,7 @@ int main(int argc, char** argv) {
   std::vector<char*> args(argv, argv + argc);
   args[0] = real_colmap.data();
   args.push_back(nullptr);
+  std::signal(SIGXFSZ, SIG_DFL);
   ::execv(real_colmap.c_str(), args.data());
   std::cerr << "ERROR: cannot run " << real_colmap << ": " << std::strerror(errno)
             << "\n";

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "colmap_ext/image_io.h"
 #include "colmap_ext/reconstruction.h"
 #include "colmap_ext/runner.h"
 #include "colmap_ext/sparse_io.h"
@@ -396,6 +397,12 @@ void RunPrepareStages(const PrepareContext& c) {
   if (images.size() < 3) {
     throw Error(c.image_path, "only " + std::to_string(images.size()) +
                                   " images: view synthesis needs at least 3 photos");
+  }
+  // COLMAP skips a photo it cannot read and aborts later (an empty file made its matcher
+  // fail a CHECK): every photo's header is read here, before the workspace is touched.
+  for (const std::string& name : images) {
+    int width = 0, height = 0;
+    colmap::ReadImageSize(JoinPaths(c.image_path, name), &width, &height);
   }
   const colmap::DenseWorkspace ws(c.workspace_path);
   const std::string fvs_dir = ws.FvsDir();

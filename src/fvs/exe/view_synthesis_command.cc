@@ -198,17 +198,51 @@ std::string GroundTruthFile(const std::string& dir, const std::string& name) {
   return "";
 }
 
-// PSNR of a rendered frame against its ground truth; -1 without one. A ground truth of
-// another size is an error (it is not the frame it claims to be).
+// A ground truth of another size than its frame is an error (it is not the frame it
+// claims to be).
+void RequireGroundTruthSize(const std::string& path, int truth_width, int truth_height,
+                            int width, int height) {
+  Require(truth_width == width && truth_height == height, path,
+          "ground truth of " + std::to_string(truth_width) + "x" +
+              std::to_string(truth_height) + " for a frame of " + std::to_string(width) +
+              "x" + std::to_string(height));
+}
+
+// Checks, from the headers, the ground truth of a frame of this size, if there is one:
+// run on every target before the first frame, so that a bad one writes nothing.
+void CheckGroundTruth(const std::string& dir, const std::string& name,
+                      const PinholeCamera& camera) {
+  const std::string path = GroundTruthFile(dir, name);
+  if (path.empty()) return;
+  int width = 0, height = 0;
+  colmap::ReadImageSize(path, &width, &height);
+  RequireGroundTruthSize(path, width, height, camera.width, camera.height);
+}
+
+// PSNR of a rendered frame against its ground truth; -1 without one.
 double FramePsnr(const std::string& dir, const std::string& name, const Image& color) {
   const std::string path = GroundTruthFile(dir, name);
   if (path.empty()) return -1;
   const Image truth = colmap::ReadImage(path);
-  Require(truth.width == color.width && truth.height == color.height, path,
-          "ground truth of " + std::to_string(truth.width) + "x" +
-              std::to_string(truth.height) + " for a frame of " +
-              std::to_string(color.width) + "x" + std::to_string(color.height));
+  RequireGroundTruthSize(path, truth.width, truth.height, color.width, color.height);
   return eval::Psnr(color, truth);
+}
+
+// Checks, from their headers only, that every view's photo exists, decodes as an image
+// and has its camera's size. The renderer reads photos lazily, when a frame first uses
+// them: checked up front, a broken photo fails before the output folder is touched.
+void CheckSourcePhotos(const Scene& scene) {
+  const colmap::DenseWorkspace workspace(scene.workspace_path());
+  for (const SceneView& view : scene.views()) {
+    const std::string path = workspace.ImagePath(view.name);
+    int width = 0, height = 0;
+    colmap::ReadImageSize(path, &width, &height);
+    Require(width == view.camera.width && height == view.camera.height, path,
+            "image is " + std::to_string(width) + "x" + std::to_string(height) +
+                " but its camera is " + std::to_string(view.camera.width) + "x" +
+                std::to_string(view.camera.height) +
+                " (not an undistorted dense workspace?)");
+  }
 }
 
 std::vector<int> ParseSources(const std::string& text) {
@@ -349,6 +383,13 @@ int RunViewSynthesis(int argc, char** argv) {
       return 0;
     }
     targets = std::move(mine);
+  }
+  // Photos are read and ground truth compared frame by frame: check them (headers only)
+  // before the output folder is touched, so that bad input leaves nothing behind.
+  CheckSourcePhotos(scene);
+  for (const TargetCamera& t : targets) {
+    CheckGroundTruth(o.ground_truth_path, t.name,
+                     ResizeTarget(t.camera, o.width, o.height, o.scale));
   }
   std::error_code ec;
   std::filesystem::create_directories(o.output_path, ec);

@@ -57,10 +57,26 @@ PatchMatchStereoSummary RunPatchMatchStereo(const std::string& workspace_path,
   Require(rec.images.size() >= 2, ws.SparseDir(),
           "stereo needs at least 2 images, the sparse model has " +
               std::to_string(rec.images.size()));
-  WriteDefaultStereoConfigs(ws.StereoDir(), rec);
+  // Bad input leaves the workspace as it was: the default configs (written when missing,
+  // as image_undistorter does) come only after the user's patch-match.cfg has parsed or,
+  // without one, after every image the defaults would list has been found readable.
   const std::string cfg_path = ws.StereoDir() + "/patch-match.cfg";
-  std::vector<StereoProblem> problems =
-      ReadPatchMatchConfig(cfg_path, rec, options.min_triangulation_angle);
+  const bool had_config = Exists(cfg_path);
+  std::vector<StereoProblem> problems;
+  if (had_config) {
+    problems = ReadPatchMatchConfig(cfg_path, rec, options.min_triangulation_angle);
+  } else {
+    for (const auto& [id, image] : rec.images) {
+      const std::string path = ws.ImagePath(image.name);
+      Require(Exists(path), path, "image file is missing (the sparse model lists it)");
+      int width = 0, height = 0;
+      colmap::ReadImageSize(path, &width, &height);  // throws for a file that is no image
+    }
+  }
+  WriteDefaultStereoConfigs(ws.StereoDir(), rec);
+  if (!had_config) {
+    problems = ReadPatchMatchConfig(cfg_path, rec, options.min_triangulation_angle);
+  }
   Require(!problems.empty(), cfg_path, "lists no images");
   summary.num_problems = static_cast<int>(problems.size());
   for (StereoProblem& p : problems) {

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fvs/net/lpips_weights.h"
+#include "fvs/net/net.h"
 #include "fvs/scene/scene.h"
 #include "fvs/train/pack.h"
 #include "fvs/train/trainer.h"
@@ -144,6 +145,10 @@ FinetuneSummary RunFinetune(const FinetuneOptions& o) {
   Timer timer;
   Require(fs::is_directory(o.workspace_path), o.workspace_path,
           "no such workspace folder");
+  // Starting weights that are missing or do not load fail here, before anything is
+  // written into the workspace: the pack below would otherwise be left behind (the
+  // trainer loads them again; a file of some megabytes, read twice).
+  if (!o.model_path.empty()) LoadModel(o.model_path, nullptr);
   const fs::path root = fs::path(o.workspace_path) / "fvs" / "finetune";
   fs::create_directories(root);
   const fs::path state_file = root / "state.json";

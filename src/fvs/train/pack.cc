@@ -209,7 +209,10 @@ PackSummary PackScene(const Scene& scene, const PackOptions& options,
   file.metadata["origin"] =
       nlohmann::json({scene.origin().x(), scene.origin().y(), scene.origin().z()}).dump();
 
-  std::filesystem::create_directories(output_dir);
+  // Not the throwing overload: its message is the library's, not "<folder>: <fault>".
+  std::error_code ec;
+  std::filesystem::create_directories(output_dir, ec);
+  Require(!ec, output_dir, "cannot create the output folder: " + ec.message());
   PackSummary summary;
   summary.path = output_dir + "/" + kPackedSceneFile;
   WriteSafeTensors(summary.path, file);
