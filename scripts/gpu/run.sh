@@ -17,8 +17,20 @@
 #      validation.csv has the network's and ulr's PSNR, SSIM and LPIPS per pass);
 #   4. copies the log, validation.csv, model.json, model.safetensors (fp16) and, where it fits,
 #      the newest checkpoint under $OUT (default gpu_out/), within what the device tool
-#      brings back: at most 8 files, 16 MiB each, 64 MiB in all; a larger file comes back as
-#      xz-compressed parts NAME.xz.partNN (join: cat NAME.xz.part* | xz -d > NAME).
+#      brings back: at most 8 files, 16 MiB each, 64 MiB in all (one file kept for step 5);
+#      a larger file comes back as xz-compressed parts NAME.xz.partNN (join:
+#      cat NAME.xz.part* | xz -d > NAME);
+#   5. the render benchmark of the trainer-only build (fvs_train_main --Train.benchmark 1,
+#      src/fvs/train/render_benchmark.h) with the weights just trained: validation views
+#      of the three validation scenes at 480x270 and 960x540, K = 1..8, fp32/bf16/fp16
+#      (fp16 on CUDA only), within FVS_BENCH_S seconds; its table goes to the log and
+#      $OUT/render_benchmark.csv;
+#   6. when python3 has torch: scripts/gpu/torch_forward_bench.py, the same layer shapes in
+#      PyTorch timed on the same device (random weights), within FVS_TORCH_BENCH_S
+#      seconds; its table goes to the log only (the 8-file limit).
+#
+# Precision: on cuda the trainer runs with --Train.precision bf16 (autocast forward, fp32
+# weights, optimiser and loss); on the CPU fp32. FVS_PRECISION overrides.
 #
 # Resume: files in gpu_resume/ (carried) are picked up. checkpoint-*.pt there is copied into
 # the output folder and the trainer continues from it (optimiser state, step and the training
@@ -30,17 +42,13 @@
 # but do not travel back in beside gpu_data/ (33 MB) either. So `fvs` trains within one
 # window only; smaller variants resume exactly.
 #
-# NOT DONE HERE, stated plainly:
-#   - bf16 autocast: the trainer has no mixed-precision option (trains in fp32; TF32 is
-#     whatever LibTorch's default is). Adding it is trainer work, not this script's.
-#   - the GPU rows of the render benchmark (480x270 and 960x540, K = 1..8, fp32/bf16/fp16):
-#     render_benchmark needs the full build (COLMAP, OpenImageIO, CGAL, SQLite), and the
-#     device has no Debian packages to build it from; this script does not fake them.
-#
-# Environment: OUT, FVS_VARIANT (fvs), FVS_DEVICE (cuda|cpu), FVS_TORCH_PREFIX,
+# Environment: OUT, FVS_VARIANT (fvs), FVS_DEVICE (cuda|cpu), FVS_PRECISION (bf16 on cuda,
+# else fp32), FVS_BENCH_S (100; 0: no render benchmark), FVS_BENCH_ARGS (extra benchmark
+# flags, e.g. "--Train.bench_ks 1,5"), FVS_TORCH_BENCH_S (40; 0: none), FVS_TORCH_PREFIX,
 # FVS_CXX_STANDARD (20 for torch >= 2.10, else 17), FVS_CMAKE_ARGS (extra configure flags),
-# FVS_TOTAL_SECONDS (540: the whole script's budget; training stops early enough to validate
-# and ship inside it), FVS_VAL_RESERVE_S (120: seconds kept for the final validation),
+# FVS_TOTAL_SECONDS (540: the whole script's budget; training stops early enough to validate,
+# ship and benchmark inside it), FVS_VAL_RESERVE_S (120: seconds kept for the final
+# validation), FVS_SHIP_S (60: kept for compressing the weights),
 # FVS_JOBS (nproc), FVS_BUILD_DIR (build-gpu), FVS_RUN_DIR (build-gpu-run).
 set -uo pipefail
 
@@ -57,6 +65,9 @@ export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-PASSIVE}
 
 TOTAL=${FVS_TOTAL_SECONDS:-540}
 VAL_RESERVE=${FVS_VAL_RESERVE_S:-120}
+BENCH_S=${FVS_BENCH_S:-100}
+TORCH_BENCH_S=${FVS_TORCH_BENCH_S:-40}
+SHIP_S=${FVS_SHIP_S:-60}
 VARIANT=${FVS_VARIANT:-fvs}
 BUILD=${FVS_BUILD_DIR:-$ROOT/build-gpu}
 RUN=${FVS_RUN_DIR:-$ROOT/build-gpu-run}
@@ -156,12 +167,21 @@ if [[ -z ${FVS_DEVICE:-} ]]; then
   FVS_DEVICE=cpu
   nvidia-smi -L >/dev/null 2>&1 && FVS_DEVICE=cuda
 fi
+if [[ -z ${FVS_PRECISION:-} ]]; then
+  FVS_PRECISION=fp32
+  [[ $FVS_DEVICE == cuda ]] && FVS_PRECISION=bf16
+fi
+TORCH_BENCH=0
+if (( TORCH_BENCH_S > 0 )) && python3 -c 'import torch' 2>/dev/null; then TORCH_BENCH=1; fi
+# Kept after training: shipping, the render benchmark, the PyTorch timing.
+POST=$(( SHIP_S + BENCH_S + TORCH_BENCH * TORCH_BENCH_S ))
 NOW=$(date +%s)
 LEFT=$(( START + TOTAL - NOW ))
-TRAIN_S=$(( LEFT - VAL_RESERVE - 30 ))
+TRAIN_S=$(( LEFT - VAL_RESERVE - POST - 30 ))
 (( TRAIN_S >= 30 )) || die "only ${LEFT}s left after the build: raise FVS_TOTAL_SECONDS"
 MAXMIN=$(python3 -c "print(min($MINUTES, $TRAIN_S/60))")
-step "train $VARIANT on $FVS_DEVICE: $MAXMIN min of training (asked $MINUTES), hard stop in $(( LEFT - 30 ))s"
+HARD_STOP=$(( LEFT - POST - 30 ))
+step "train $VARIANT on $FVS_DEVICE in $FVS_PRECISION: $MAXMIN min of training (asked $MINUTES), hard stop in ${HARD_STOP}s"
 # Training time counts over invocations (kept in the checkpoint): a resumed run's limit is
 # the time recorded in the model.json that came back with the checkpoint plus this run's.
 TOTAL_MIN=$MAXMIN
@@ -178,10 +198,10 @@ print(done + add)
 EOF
 )
 fi
-timeout -s INT -k 20 $(( LEFT - 30 )) "$TRAINER" \
+timeout -s INT -k 20 "$HARD_STOP" "$TRAINER" \
   --scene_list "$DATA/train.txt" --val_scene_list "$DATA/val.txt" \
   --output_path "$M" --lpips_path "$DATA/lpips_alex.safetensors" \
-  --Train.variant "$VARIANT" --Train.device "$FVS_DEVICE" \
+  --Train.variant "$VARIANT" --Train.device "$FVS_DEVICE" --Train.precision "$FVS_PRECISION" \
   --Train.max_steps 1000000 --Train.max_train_minutes "$TOTAL_MIN" \
   --Train.fp16_weights 1 --Train.checkpoint_minutes 2 --Train.log_every 20 \
   "${INIT[@]}" "$@"
@@ -189,12 +209,15 @@ RC=$?
 step "trainer exit $RC"
 [[ -f $M/validation.csv ]] && tail -8 "$M/validation.csv"
 
-# 4. Bring back what fits: 8 files, 16 MiB each, 64 MiB in all (run.log is one of them).
+# 4. Bring back what fits: 8 files, 16 MiB each, 64 MiB in all (run.log is one of them, and
+# one is kept for the benchmark's CSV).
 step "ship to $OUT"
-python3 - "$M" "$OUT" <<'EOF'
+KEEP_FILES=0
+(( BENCH_S > 0 )) && KEEP_FILES=1
+python3 - "$M" "$OUT" "$KEEP_FILES" <<'EOF'
 import glob, lzma, os, shutil, sys
 m, out = sys.argv[1], sys.argv[2]
-FILE, TOTAL, NFILES = 16 * 2**20 - 4096, 63 * 2**20, 8
+FILE, TOTAL, NFILES = 16 * 2**20 - 4096, 63 * 2**20 - 2**20 * int(sys.argv[3]), 8 - int(sys.argv[3])
 used = [os.path.getsize(os.path.join(out, f)) + 2 * 2**20 for f in os.listdir(out)]  # log grows
 count, size = len(used), sum(used)
 def put(src, name):
@@ -228,6 +251,46 @@ cks = sorted(glob.glob(os.path.join(m, "checkpoint-*.pt")),
 if cks:
     put(cks[-1], os.path.basename(cks[-1]))
 EOF
+
+# 5. The render benchmark (trainer-only build): the weights just trained, else a fresh
+# network (timing only; the CSV's PSNR then means nothing).
+if (( BENCH_S > 0 )); then
+  WEIGHTS=()
+  [[ -f $M/model.safetensors ]] && WEIGHTS=(--Train.init_weights "$M/model.safetensors")
+  NOW=$(date +%s)
+  B=$(( START + TOTAL - NOW - TORCH_BENCH * TORCH_BENCH_S - 10 ))
+  (( B > BENCH_S )) && B=$BENCH_S
+  if (( B >= 30 )); then
+    step "render benchmark on $FVS_DEVICE: ${B}s (grid bound $(( B - 25 ))s)"
+    # shellcheck disable=SC2086
+    timeout -s INT -k 10 "$B" "$TRAINER" \
+      --scene_list "$DATA/val.txt" --val_scene_list "$DATA/val.txt" \
+      --output_path "$RUN/bench" --Train.benchmark 1 --Train.variant "$VARIANT" \
+      --Train.device "$FVS_DEVICE" --Train.bench_seconds $(( B - 25 )) "${WEIGHTS[@]}" \
+      ${FVS_BENCH_ARGS:-}
+    step "render benchmark exit $?"
+    cp "$RUN/bench/render_benchmark.csv" "$OUT/" 2>/dev/null || echo "no render_benchmark.csv"
+  else
+    echo "render benchmark skipped: ${B}s left"
+  fi
+fi
+
+# 6. The same layer shapes in PyTorch, on the same device (table in the log only).
+if (( TORCH_BENCH )); then
+  NOW=$(date +%s)
+  B=$(( START + TOTAL - NOW - 10 ))
+  (( B > TORCH_BENCH_S )) && B=$TORCH_BENCH_S
+  if (( B >= 15 )); then
+    CARD=()
+    [[ -f $M/model.json ]] && CARD=(--config "$M/model.json")
+    step "PyTorch forward of the same layers: ${B}s"
+    timeout -k 5 "$B" python3 "$ROOT/scripts/gpu/torch_forward_bench.py" "${CARD[@]}" \
+      --device "$FVS_DEVICE" --seconds $(( B - 15 ))
+    step "PyTorch forward exit $?"
+  fi
+else
+  echo "PyTorch forward timing skipped: python3 has no torch (or FVS_TORCH_BENCH_S=0)"
+fi
 ls -l "$OUT"
 step "done (trainer exit $RC)"
 exit $RC

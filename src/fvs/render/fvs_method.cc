@@ -12,6 +12,7 @@
 
 #include "fvs/net/image_tensor.h"
 #include "fvs/net/net.h"
+#include "fvs/net/precision.h"
 #include "fvs/render/feature_store.h"
 #include "fvs/render/prepare.h"
 #include "fvs/render/ulr.h"
@@ -355,9 +356,7 @@ std::unique_ptr<Method> CreateFvsMethod(const std::string& requested,
                 "fp16 needs a CUDA device (LibTorch's CPU convolutions have no fp16; "
                 "bf16 runs on the CPU)");
   }
-  const torch::ScalarType dtype = options.precision == "bf16"   ? torch::kBFloat16
-                                  : options.precision == "fp16" ? torch::kHalf
-                                                                : torch::kFloat32;
+  const torch::ScalarType dtype = PrecisionDtype(options.precision);
   ModelConfig config;
   FvsNet net = LoadModel(options.model_path, &config);
   if (requested != "fvs" && requested != config.variant) {

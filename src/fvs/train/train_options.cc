@@ -50,6 +50,9 @@ std::vector<OptionSpec> Specs(TrainOptions* o) {
        "> 0: also stop and write the model once the training time of all invocations "
        "reaches this"},
       {"Train.device", Kind::kString, &o->device, false, "auto | cpu | cuda"},
+      {"Train.precision", Kind::kString, &o->precision, false,
+       "fp32 | bf16: bf16 runs the forward pass under autocast (fp32 weights, "
+       "gradients, optimiser and loss)"},
       {"Train.max_steps", Kind::kInt, &o->max_steps, false, "optimiser steps in all"},
       {"Train.num_sources", Kind::kInt, &o->num_sources, false,
        "K: sources per target (top-K by overlap)"},
@@ -81,6 +84,20 @@ std::vector<OptionSpec> Specs(TrainOptions* o) {
       {"Train.headroom", Kind::kBool, &o->headroom, false,
        "only measure ulr and the per-pixel and global oracles on the validation "
        "views (M/headroom.csv), no training"},
+      {"Train.benchmark", Kind::kBool, &o->benchmark, false,
+       "only the render benchmark: validation views of --val_scene_list rendered at "
+       "--Train.bench_sizes, K in --Train.bench_ks, --Train.bench_precisions "
+       "(M/render_benchmark.csv); weights of --Train.init_weights, else a fresh network"},
+      {"Train.bench_sizes", Kind::kString, &o->bench_sizes, false,
+       "render benchmark: WxH sizes, comma separated"},
+      {"Train.bench_ks", Kind::kString, &o->bench_ks, false,
+       "render benchmark: numbers of sources, comma separated, in the order run"},
+      {"Train.bench_precisions", Kind::kString, &o->bench_precisions, false,
+       "render benchmark: fp32, bf16, fp16 (fp16 on CUDA only)"},
+      {"Train.bench_seconds", Kind::kDouble, &o->bench_seconds, false,
+       "render benchmark: time bound; cells that would pass it are skipped"},
+      {"Train.bench_views", Kind::kInt, &o->bench_views, false,
+       "render benchmark: validation views per scene in each cell"},
       {"Train.num_threads", Kind::kInt, &o->num_threads, false,
        "LibTorch CPU threads (<= 0: FVS_NUM_THREADS or all cores)"},
   };
@@ -154,6 +171,59 @@ void TrainOptions::Check() const {
   Require(loss != "l1+vgg19" || !vgg19_path.empty(), kSubject,
           "--Train.loss l1+vgg19 needs --vgg19_path");
   Require(lpips_weight > 0, kSubject, "--Train.lpips_weight must be positive");
+  Require(precision == "fp32" || precision == "bf16", kSubject,
+          "--Train.precision must be fp32 or bf16, not '" + precision +
+              "' (fp16 training would need loss scaling)");
+  if (benchmark) {
+    Require(!val_scene_list.empty(), kSubject, "--Train.benchmark needs --val_scene_list");
+    Require(bench_seconds > 0, kSubject, "--Train.bench_seconds must be positive");
+    Require(bench_views >= 1, kSubject, "--Train.bench_views must be at least 1");
+    ParseBenchmarkGrid(*this);  // throws on a malformed list
+  }
+}
+
+BenchmarkGrid ParseBenchmarkGrid(const TrainOptions& o) {
+  auto split = [](const std::string& list) {
+    std::vector<std::string> items;
+    std::stringstream in(list);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+      item = TrimString(item);
+      if (!item.empty()) items.push_back(item);
+    }
+    return items;
+  };
+  auto to_int = [](const std::string& s, const std::string& what) {
+    size_t used = 0;
+    int v = 0;
+    try {
+      v = std::stoi(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    Require(used == s.size() && v >= 1, kSubject,
+            what + ": '" + s + "' is not a positive whole number");
+    return v;
+  };
+  BenchmarkGrid grid;
+  for (const std::string& s : split(o.bench_sizes)) {
+    const size_t x = s.find('x');
+    Require(x != std::string::npos, kSubject,
+            "--Train.bench_sizes: '" + s + "' is not WxH");
+    grid.sizes.push_back({to_int(s.substr(0, x), "--Train.bench_sizes"),
+                          to_int(s.substr(x + 1), "--Train.bench_sizes")});
+  }
+  for (const std::string& s : split(o.bench_ks)) {
+    grid.ks.push_back(to_int(s, "--Train.bench_ks"));
+  }
+  for (const std::string& s : split(o.bench_precisions)) {
+    Require(s == "fp32" || s == "bf16" || s == "fp16", kSubject,
+            "--Train.bench_precisions: '" + s + "' must be fp32, bf16 or fp16");
+    grid.precisions.push_back(s);
+  }
+  Require(!grid.sizes.empty() && !grid.ks.empty() && !grid.precisions.empty(), kSubject,
+          "--Train.benchmark needs at least one size, K and precision");
+  return grid;
 }
 
 std::string TrainUsage(const std::string& program) {

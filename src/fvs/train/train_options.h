@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fvs {
@@ -26,6 +27,10 @@ struct TrainOptions {
   // a checkpoint in M still wins (resume). Fine-tuning (train/finetune.h) uses it.
   std::string init_weights;
   std::string device = "auto";  // auto | cpu | cuda
+  // fp32 | bf16: bf16 runs each step's forward pass under autocast (convolutions in
+  // bf16; fp32 master weights, gradients and Adam; the loss, LPIPS included, in fp32).
+  // fp16 is not offered (it would need loss scaling). Validation stays fp32.
+  std::string precision = "fp32";
   int max_steps = 100000;
   // > 0: also stop, writing the model as at max_steps, once the run's training time (all
   // invocations, the card's "hours") reaches this many minutes.
@@ -52,12 +57,31 @@ struct TrainOptions {
   // Only measure the headroom of the validation scenes (train/headroom.h) into
   // M/headroom.csv; no training.
   bool headroom = false;
+  // Only the trainer-only render benchmark (train/render_benchmark.h): renders
+  // validation views of --val_scene_list with the network (--Train.init_weights, else a
+  // fresh --Train.variant: timing only) and ulr, into M/render_benchmark.csv; no
+  // training.
+  bool benchmark = false;
+  std::string bench_sizes = "480x270,960x540";  // WxH list
+  std::string bench_ks = "1,2,3,4,5,6,7,8";      // K list, in the order run
+  std::string bench_precisions = "fp32,bf16,fp16";  // fp16 skipped on the CPU
+  double bench_seconds = 240;  // the grid's time bound (cells that would pass it skipped)
+  int bench_views = 1;         // validation views per scene per cell
   // Tests: replaces the variant's layout with this JSON (ModelConfig::FromJson).
   std::string model_config_json;
 
   // Throws fvs::Error("view_synthesis_train", ...) for impossible values.
   void Check() const;
 };
+
+// The render benchmark's grid, parsed from TrainOptions::bench_*; throws fvs::Error on a
+// malformed list.
+struct BenchmarkGrid {
+  std::vector<std::pair<int, int>> sizes;  // width, height
+  std::vector<int> ks;
+  std::vector<std::string> precisions;
+};
+BenchmarkGrid ParseBenchmarkGrid(const TrainOptions& options);
 
 // Parses argv[first..argc): `--scene_list L`, `--Train.max_steps N`, ... (every option
 // has a `Train.` name; the path options also a bare one). Returns false when help was

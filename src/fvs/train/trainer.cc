@@ -16,7 +16,10 @@
 
 #include "fvs/net/image_tensor.h"
 #include "fvs/net/lpips_weights.h"
+#include "fvs/net/precision.h"
 #include "fvs/train/headroom.h"
+#include "fvs/train/packed_render.h"
+#include "fvs/train/render_benchmark.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
 #include "fvs/util/hole_filling.h"
@@ -78,33 +81,10 @@ std::string UtcNow() {
   return buf;
 }
 
-struct DeviceSample {
-  torch::Tensor target, sources, grid, valid_depth, valid_warp, ulr_log_weights;
-};
-DeviceSample ToDevice(const TrainingSample& s, const torch::Device& device) {
-  auto to = [&](const torch::Tensor& t) { return t.defined() ? t.to(device) : t; };
-  return {to(s.target_rgb),       to(s.source_rgb),      to(s.warp.grid),
-          to(s.warp.valid_depth), to(s.warp.valid_warp), to(s.warp.ulr_log_weights)};
-}
-
 void SetUlrPrior(const ModelConfig& config, WarpSettings* warp) {
   warp->ulr_log_weights = config.ulr_prior > 0;
   warp->ulr.num_blend = config.ulr_num_blend;
   warp->ulr.resolution_weight = config.ulr_resolution_weight;
-}
-
-// PSNR, SSIM and (with LPIPS weights) LPIPS of a [1,3,H,W] image in [0, 1].
-struct ViewScores {
-  double psnr = 0, ssim = 0, lpips = 0;
-};
-ViewScores ScoreView(const torch::Tensor& image, const torch::Tensor& target,
-                     LpipsNet lpips) {
-  ViewScores scores;
-  const double mse = (image - target).pow(2).mean().item<double>();
-  scores.psnr = 10.0 * std::log10(1.0 / std::max(mse, 1e-10));
-  scores.ssim = Ssim(image, target).item<double>();
-  if (!lpips.is_empty()) scores.lpips = lpips->forward(image, target).item<double>();
-  return scores;
 }
 
 // The quality sums of a scene or of all scenes (ValidationResult and its Scene share
@@ -246,6 +226,7 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
              (options_.device == "auto" && torch::cuda::is_available()))
                 ? torch::Device(torch::kCUDA)
                 : torch::Device(torch::kCPU);
+  dtype_ = PrecisionDtype(options_.precision, "--Train.precision");
 
   // Before the scenes: a bad weights file should not wait for them to load.
   LoadLpipsWeights();
@@ -309,8 +290,15 @@ LossValue Trainer::Step() {
   const int b = options_.batch_size;
   for (int i = 0; i < b; ++i) {
     const DeviceSample s = ToDevice(sampler_->Next(), device_);
-    const BlendOutput out =
-        net_->Forward(s.sources, s.grid, s.valid_depth, s.valid_warp, s.ulr_log_weights);
+    BlendOutput out;
+    {
+      // --Train.precision bf16: the forward pass under autocast (convolutions in bf16,
+      // fp32 master weights); the loss below in fp32, outside it.
+      AutocastGuard autocast(device_, dtype_);
+      out = net_->Forward(s.sources, s.grid, s.valid_depth, s.valid_warp,
+                          s.ulr_log_weights);
+    }
+    out.rgb = out.rgb.to(torch::kFloat32);
     // Pixels no source sees are filled classically at render time (util/hole_filling.h):
     // the net is not asked to invent them (it would learn the training set's sky).
     const torch::Tensor seen = s.valid_warp.sum(0, true) > 0;
@@ -351,27 +339,12 @@ ValidationResult Trainer::Validate() {
     for (const int target : ValidationTargets(scene, options_.val_views)) {
       const auto sources = SelectTrainingSources(scene, target, options_.num_sources);
       if (sources.empty()) continue;
-      const TrainingSample sample =
-          MakeSample(scene, target, sources, 0, 0, scene.width(), scene.height(), warp);
-      Timer timer;
-      const DeviceSample s = ToDevice(sample, device_);
-      const BlendOutput out = net_->Forward(s.sources, s.grid, s.valid_depth,
-                                            s.valid_warp, s.ulr_log_weights);
-      const torch::Tensor covered = s.valid_warp.sum(0, true) > 0;
-      // As the renderer: holes (no source sees the pixel) filled from around them.
-      const torch::Tensor prediction =
-          FillHolesOf(((out.rgb + 1.0) * 0.5).clamp(0.0, 1.0), covered, s.valid_depth);
-      if (device_.is_cuda()) torch::cuda::synchronize();
-      seconds += timer.Seconds();
-      const torch::Tensor ulr = FillHolesOf(
-          (((SoftmaxWeights(s.ulr_log_weights) * WarpFeatures(s.sources, s.grid))
-                .sum(0, true) +
-            1.0) *
-           0.5)
-              .clamp(0.0, 1.0),
-          covered, s.valid_depth);
-      const ViewScores net = ScoreView(prediction, s.target, lpips_);
-      const ViewScores base = ScoreView(ulr, s.target, lpips_);
+      // Always fp32 (whatever --Train.precision): figures comparable across runs.
+      const PackedViewRender v = RenderPackedView(net_, scene, target, sources, warp,
+                                                  device_, torch::kFloat32, true);
+      seconds += v.warp_s + v.network_s + v.rest_s;
+      const ViewScores net = ScoreView(v.prediction, v.target, lpips_);
+      const ViewScores base = ScoreView(v.ulr, v.target, lpips_);
       r.psnr += net.psnr;
       r.ssim += net.ssim;
       r.lpips += net.lpips;
@@ -435,6 +408,7 @@ std::string Trainer::SaveModel(const std::string& stem) {
   card["steps"] = step_;
   card["batch_size"] = options_.batch_size;
   card["crop"] = options_.crop;
+  card["precision"] = options_.precision;
   card["source_margin"] = options_.source_margin;
   card["num_sources"] = options_.num_sources;
   card["learning_rate"] = options_.learning_rate;
@@ -601,6 +575,7 @@ TrainSummary RunHeadroom(const TrainOptions& options) {
 
 TrainSummary RunTraining(const TrainOptions& options) {
   if (options.headroom) return RunHeadroom(options);
+  if (options.benchmark) return RunRenderBenchmark(options);
   return Trainer(options).Run();
 }
 

@@ -83,6 +83,7 @@ class Trainer {
   TrainOptions options_;
   ModelConfig config_;
   torch::Device device_ = torch::kCPU;
+  torch::ScalarType dtype_ = torch::kFloat32;  // of the forward pass (--Train.precision)
   std::vector<PackedScene> train_scenes_, val_scenes_;
   FvsNet net_{nullptr};
   std::unique_ptr<torch::optim::Adam> optimizer_;
