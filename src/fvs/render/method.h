@@ -104,7 +104,7 @@ struct RenderResult {
   Image confidence;  // 1 channel in [0, 1]; 0 where not covered
   Image coverage;    // 1 channel, 1 where at least one source contributed
   // 1 channel, 1 where the pixel has no surface (depth 0) but some source sees it at
-  // infinity (scene/warp.h), so it was rendered from the background beyond the mesh;
+  // infinity (geometry/warp.h), so it was rendered from the background beyond the mesh;
   // AtInfinityMask of depth and coverage.
   Image infinity;
   std::vector<SourceScore> sources;  // used, best first
