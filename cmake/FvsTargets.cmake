@@ -18,8 +18,8 @@ function(fvs_add_library NAME)
   endif()
 endfunction()
 
-# One precompiled torch/torch.h shared by every LibTorch translation unit: a file including
-# it compiles in ~15 s without, 7-10 s with.
+# One precompiled torch/torch.h shared by every LibTorch translation unit: torch/torch.h is
+# most of such a file's compile time (doc/design.md has the figures).
 function(fvs_use_torch_pch TARGET)
   if(NOT TARGET fvs_torch_pch)
     file(WRITE ${CMAKE_BINARY_DIR}/fvs_torch_pch.cc "// precompiled-header anchor\n")
@@ -35,7 +35,7 @@ endfunction()
 # XVFB: the test opens windows with OpenGL; it runs under xvfb-run (Mesa's llvmpipe gives
 # real GL there; Qt's offscreen platform has none) with QT_QPA_PLATFORM=xcb.
 # One executable and one ctest entry per test file group: a binary linking OIIO loads OpenCV
-# (~0.5 s), so a process per GoogleTest case would waste minutes on 2 cores.
+# at start-up (doc/design.md), so a process per GoogleTest case would waste minutes.
 function(fvs_add_test NAME)
   cmake_parse_arguments(T "TORCH;XVFB" "TIMEOUT" "SRCS;DEPS;LABELS" ${ARGN})
   add_executable(${NAME} ${T_SRCS})

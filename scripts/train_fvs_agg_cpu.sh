@@ -71,7 +71,7 @@ done
 
 # Validation first (small), then training scenes, smallest first.
 # middlebury_dino (a black backdrop like the temple's) and wall_clock fail in the mapper
-# with every 2nd photo, so they take all of them (~10 min each here).
+# with every 2nd photo, so they take all of them (slower to prepare).
 for spec in middlebury_temple:1:1 monstree:1:1 fox:2:1 sceaux_castle:1:0 \
             beer:3:0 scodive:3:0 alexander:2:0 mary_rose:3:0 gold_cape:4:0 \
             middlebury_dino:1:0 wall_clock:1:0; do

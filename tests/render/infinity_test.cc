@@ -1,6 +1,6 @@
 // The background beyond the proxy mesh (issue 17): a scene whose far "sky" is in the
 // photos but not in the mesh (MakeTestSkyScene). Its pixels have no target depth; the
-// renderers warp them from the sources at infinity (scene/warp.h) and must give the
+// renderers warp them from the sources at infinity (geometry/warp.h) and must give the
 // background back, where push-pull hole filling (the old fate of those pixels) smears
 // the floor and the box over it.
 #include <gtest/gtest.h>

@@ -50,7 +50,7 @@ TEST(FinetuneTest, PublishesWithinBudgetResumesAndKeepsHoldoutOut) {
   const std::string held = scene.view(2).name;
   WriteFileAtomic(ws + "/fvs/holdout.txt", [&](std::ostream& f) { f << held << "\n"; });
 
-  FinetuneSummary first = RunFinetune(SmallRun(ws, 0.05));  // 3 s
+  FinetuneSummary first = RunFinetune(SmallRun(ws, 0.05));
   ASSERT_FALSE(first.interrupted);
   EXPECT_TRUE(first.init_path.empty());  // no generic weights given: the initial ones
   EXPECT_EQ(first.model_path, WorkspaceFinetunedModelDir(ws) + "/fvs_agg.safetensors");

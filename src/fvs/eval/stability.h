@@ -3,7 +3,7 @@
 // edges, each rendered at the origin and again with the whole world 10 km away, with
 // every method asked for. Per case and method: NaN and Inf counts in the outputs (colour,
 // confidence, depth), the maximum colour deviation between the two placements, and time.
-// The cases (DESIGN.md, "Numbers that matter"):
+// The cases (doc/design.md, "Numbers that matter"):
 //   depth_0        a target that sees only sky (target depth 0 everywhere)
 //   depth_1e30     a target that sees a backdrop 1e30 away
 //   behind_sources a target whose every point is behind every source camera

@@ -33,9 +33,9 @@ std::vector<std::string> ListImageFiles(const std::string& folder);
 bool LooksLikeVideoFrames(const std::vector<std::string>& names);
 
 // Up to this many photos --Matching.type auto matches every pair (exhaustive), whatever
-// the names: n (n - 1) / 2 pairs, 19,900 at 200. CPU SIFT matching took 0.1-0.9 s per
-// pair on the shared scenes here (2 cores), so 200 photos are about 0.5-5 core-hours,
-// comparable to CPU stereo on them; COLMAP's GPU matcher is some 50 times faster.
+// the names: n (n - 1) / 2 pairs, 19,900 at 200. On a CPU that many pairs cost about as
+// much as CPU stereo on the same photos, and COLMAP's GPU matcher is far faster
+// (doc/pipeline.md, Matching, has the figures).
 constexpr int kMaxExhaustiveImages = 200;
 constexpr int kMaxExhaustiveImagesGpu = 1000;
 

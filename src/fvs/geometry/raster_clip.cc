@@ -87,8 +87,8 @@ __attribute__((always_inline)) inline void TransformFour(const PinholeCamera& ca
 
 }  // namespace
 
-// An AVX2 clone chosen at load time where the CPU has it (2.5x faster than SSE2 here),
-// the same roundings either way: no FMA (geometry is built with -ffp-contract=off).
+// An AVX2 clone chosen at load time where the CPU has it (faster than SSE2:
+// benchmark/README_rasterizer.md), the same roundings either way: no FMA (geometry is built with -ffp-contract=off).
 #if defined(__x86_64__) && defined(__GNUC__) && defined(__ELF__)
 __attribute__((target_clones("avx2", "default")))
 #endif

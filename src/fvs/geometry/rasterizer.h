@@ -43,7 +43,7 @@ RasterResult Rasterize(const TriangleMesh& mesh, const PinholeCamera& camera,
 
 // Reference: depth by casting one ray per pixel centre through every triangle (slow,
 // exact; for tests and the benchmark's accuracy figure). Optionally restricted to rows
-// [y0, y1) (other rows are 0). Uses a BVH built per call (about 1 s per 1 M faces); hits
+// [y0, y1) (other rows are 0). Uses a BVH built per call (its cost grows with the faces); hits
 // at any depth > 0 count, faces with a non-finite vertex are skipped, no culling.
 Image RayCastDepth(const TriangleMesh& mesh, const PinholeCamera& camera, int y0 = 0,
                    int y1 = -1);

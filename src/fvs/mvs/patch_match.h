@@ -24,8 +24,8 @@ struct PatchMatchOptions {
   // window fattens occluding edges least: on the synthetic room (320x240) radius 3
   // step 1 gave 82% of textured pixels within 1%, radius 5 step 2 70%, radius 7 step 2
   // 63%. Radius 3 step 2 (16 samples instead of 49) halves the time for under a point
-  // (patch_match_benchmark, generated room, geometric pass: 400x300 84.1% -> 83.3% at
-  // 8.8 -> 4.3 s per image, 800x600 83.9% -> 83.5% at 23.1 -> 10.8 s, 2 cores).
+  // of accuracy on the generated room, in the geometric pass, at 400x300 and at 800x600
+  // (patch_match_benchmark; benchmark/README_patch_match.md has the figures).
   int window_radius = 3;
   int window_step = 2;
   // Photometric iterations (each one sweeps both checkerboard colours).

@@ -52,11 +52,10 @@ ModelConfig ModelConfig::ForVariant(const std::string& name) {
     // two convs per stage (conv + ConvGRU). Still recurrent at every level, with
     // per-source confidences. The blend widths grow slowly with depth because a stage
     // costs width^2 / 4^level: doubling per level (16/32/64/128) made every level cost
-    // the same, 4x the full-resolution one in all, for 33 GFLOPs per source at 480x270
-    // (2.9 s per frame at K = 5 on 2 cores); these widths cost 18. Dense convs on
-    // purpose: LibTorch 1.13's CPU depthwise convs are slow (measured on 2 cores: a
-    // depthwise-separable variant of 4 GFLOPs encoded in 5.2 s, the 125 GFLOPs dense
-    // encoder in 8.8 s); depthwise_separable stays available for GPUs.
+    // the same, 4x the full-resolution one in all, for 33 GFLOPs per source at 480x270;
+    // these widths cost 18. Dense convs on purpose: LibTorch 1.13's CPU depthwise convs
+    // are slow, slower per FLOP by far than dense ones (doc/network.md has the timings);
+    // depthwise_separable stays available for GPUs.
     c.feature_channels = 32;
     c.encoder_channels = {32, 64, 128};
     c.encoder_convs = {1, 1, 2};

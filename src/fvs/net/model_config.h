@@ -26,7 +26,7 @@ struct ModelConfig {
   // Per-source RGB + confidence, softmax over sources. false: one RGB head on the final
   // state.
   bool soft_argmax = true;
-  // Pixels without target depth are warped at infinity (scene/warp.h); false: they have
+  // Pixels without target depth are warped at infinity (geometry/warp.h); false: they have
   // no valid warp.
   bool inf_depth = true;
   // Encoder: VGG16 stage widths and conv counts (stages 1-3); decoder mirrors the widths.

@@ -12,7 +12,7 @@
 // The 1 / p_i factor (as in later ULR implementations) makes a target that coincides with
 // a source reproduce that source exactly.
 //
-// Pixels without a surface (seen at infinity, scene/warp.h) have no point to measure the
+// Pixels without a surface (seen at infinity, geometry/warp.h) have no point to measure the
 // angle at: at infinity every source's ray is parallel to the target's and all angles
 // are 0. They are weighed at the point D_far along their ray instead
 // (UlrPointAtInfinity), D_far = kUlrFarFactor (10) times the distance from the target

@@ -10,7 +10,7 @@
 #include "fvs/path/path_spline.h"
 #include "fvs/scene/scene.h"
 #include "fvs/scene/source_selection.h"
-#include "fvs/scene/warp.h"
+#include "fvs/geometry/warp.h"
 #include "fvs/util/error.h"
 
 namespace fvs {

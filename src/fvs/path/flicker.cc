@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "fvs/scene/warp.h"
+#include "fvs/geometry/warp.h"
 #include "fvs/util/error.h"
 #include "fvs/util/parallel.h"
 

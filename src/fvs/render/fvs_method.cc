@@ -112,16 +112,15 @@ class FvsMethod : public Method {
     net_->eval();
     net_->to(device_, dtype_);
     // Tiles by default: fvs_agg's narrow full-resolution layers are bound by memory
-    // traffic, and tiles of 160 pixels that stay in cache render 480x270 at K = 5 about
-    // 4x faster than one 512 tile (benchmark/README_render.md); its receptive field
+    // traffic, and tiles of 160 pixels that stay in cache render far faster than one 512
+    // tile (benchmark/README_render.md); its receptive field
     // reaches less than 24 pixels (the tiled-equals-whole test). The encoder-decoder
     // variants keep 512 and 32.
     const bool aggregate = config_.blender == "aggregate";
     if (options_.tile_size < 0) options_.tile_size = aggregate ? 160 : 512;
     if (options_.tile_overlap < 0) options_.tile_overlap = aggregate ? 24 : 32;
-    // Channels-last: oneDNN's convolutions run 15-25 % faster on it on this CPU (measured
-    // on the demo path, 480x360, K = 5: 3.0-3.3 s against 3.4-4.4 s per frame, noisy
-    // machine), and it is the layout CUDA's tensor cores want.
+    // Channels-last: oneDNN's convolutions run faster on it on a CPU
+    // (benchmark/README_render.md), and it is the layout CUDA's tensor cores want.
     for (auto& p : net_->parameters()) {
       if (p.dim() == 4) p.set_data(p.contiguous(torch::MemoryFormat::ChannelsLast));
     }

@@ -83,9 +83,9 @@ struct RenderOptions {
   // of at most tile_size x tile_size, each computed with tile_overlap more pixels of
   // context on every side and cropped, so that memory stays bounded for any target size
   // (the blending U-Net's activations and the warped features scale with the pixels of a
-  // tile, not of the target). Also faster on a CPU (cache): fvs_fast at 1920x1080, K = 5,
-  // 2 cores: untiled 41 s per frame and 7.5 GB, tiles of 1024 34 s and 3.1 GB, of 512
-  // 27 s and 2.4 GB. 0 = never tile; -1 (default) = the network's own (fvs_agg 160 and
+  // tile, not of the target). Also faster on a CPU: tiles stay in cache (doc/network.md,
+  // "Large targets: tiles", has the figures: time and peak memory per tile size).
+  // 0 = never tile; -1 (default) = the network's own (fvs_agg 160 and
   // 24, the others 512 and 32; render/fvs_method.cc).
   int tile_size = -1;
   int tile_overlap = -1;
@@ -108,7 +108,7 @@ struct RenderResult {
   Image confidence;  // 1 channel in [0, 1]; 0 where not covered
   Image coverage;    // 1 channel, 1 where at least one source contributed
   // 1 channel, 1 where the pixel has no surface (depth 0) but some source sees it at
-  // infinity (scene/warp.h), so it was rendered from the background beyond the mesh;
+  // infinity (geometry/warp.h), so it was rendered from the background beyond the mesh;
   // AtInfinityMask of depth and coverage.
   Image infinity;
   std::vector<SourceScore> sources;  // used, best first

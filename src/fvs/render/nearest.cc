@@ -1,5 +1,5 @@
 // `nearest`: the best-ranked source alone, reprojected through the target depth; pixels
-// without a surface take its colour where it sees them at infinity (scene/warp.h), as
+// without a surface take its colour where it sees them at infinity (geometry/warp.h), as
 // the others where it sees their surface.
 #include <algorithm>
 #include <cmath>

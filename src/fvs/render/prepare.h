@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "fvs/render/method.h"
-#include "fvs/scene/warp.h"
+#include "fvs/geometry/warp.h"
 
 namespace fvs {
 

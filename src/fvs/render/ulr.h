@@ -2,7 +2,7 @@
 // baseline without a network: the K selected sources' colours, warped with the same
 // target depth and masks as the network sees, blended per pixel with ULR weights
 // (net/ulr_weights.h, shared with the network's prior). Pixels without a surface are
-// blended from the sources that see them at infinity (scene/warp.h); pixels no source
+// blended from the sources that see them at infinity (geometry/warp.h); pixels no source
 // sees stay black (coverage 0).
 #pragma once
 

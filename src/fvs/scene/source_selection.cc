@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "fvs/scene/scene.h"
-#include "fvs/scene/warp.h"
+#include "fvs/geometry/warp.h"
 #include "fvs/util/error.h"
 #include "fvs/util/parallel.h"
 
@@ -52,7 +52,7 @@ Visibility SourceVisibility(const PinholeCamera& target, const Image& target_dep
       const bool surface = d > 0 && std::isfinite(d);
       if (!surface && !with_infinity) continue;
       const double nx = (x + 0.5 - target.cx) / target.fx;
-      // At infinity the direction alone, rotated (scene/warp.h).
+      // At infinity the direction alone, rotated (geometry/warp.h).
       const Eigen::Vector3d X =
           surface ? Eigen::Vector3d(R_rel * Eigen::Vector3d(nx * d, ny * d, d) + t_rel)
                   : Eigen::Vector3d(R_rel * Eigen::Vector3d(nx, ny, 1));

@@ -5,7 +5,7 @@
 // own depth at the nearest source pixel. Target pixels without a surface look at the
 // background beyond the mesh: a source sees one when the pixel's direction, rotated into
 // the source (no translation at infinity), lands inside it where it has no surface
-// either (the warp's test, scene/warp.h). Sources rank by surface count, then by
+// either (the warp's test, geometry/warp.h). Sources rank by surface count, then by
 // background count, so a target of sky alone still gets the sources that see its sky;
 // sources that see nothing are never returned, so they are never encoded.
 //

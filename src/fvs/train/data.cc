@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "fvs/geometry/warp.h"
 #include "fvs/net/image_tensor.h"
 #include "fvs/util/error.h"
 #include "fvs/util/hole_filling.h"
@@ -135,85 +136,70 @@ torch::Tensor FillHolesOf(const torch::Tensor& rgb, const torch::Tensor& covered
 
 namespace {
 
-// The source depth [K, hw] at the source pixels (xx, yy) (whole numbers held as doubles).
-torch::Tensor GatherDepth(const torch::Tensor& depths, int64_t width,
-                          const torch::Tensor& yy, const torch::Tensor& xx) {
-  return torch::gather(depths, 1, (yy * width + xx).to(torch::kLong));
-}
-
-// The occlusion tests of scene/warp.h on [K, hw] source positions (u, v) inside the
-// sources: for a target surface point at source depth z, the source depth at the nearest
-// pixel (no surface = invalid_depth) or interpolated between the 4 nearest pixel centres
-// when all 4 are surface; for a pixel at infinity, no surface at the nearest pixel.
-torch::Tensor SourceSees(const torch::Tensor& depths, int64_t sw, int64_t sh,
-                         const torch::Tensor& u, const torch::Tensor& v,
-                         const torch::Tensor& z, const torch::Tensor& surface,
-                         const WarpSettings& settings) {
-  const double tol = settings.occlusion_tolerance;
-  const torch::Tensor sx = torch::clamp(u.floor(), 0, sw - 1);
-  const torch::Tensor sy = torch::clamp(v.floor(), 0, sh - 1);
-  const torch::Tensor nearest = GatherDepth(depths, sw, sy, sx);
-  const torch::Tensor sees_infinity = nearest <= 0;
-  const torch::Tensor ds = torch::where(
-      nearest > 0, nearest, torch::full_like(nearest, settings.invalid_depth));
-  const torch::Tensor nearest_ok = (z - ds).abs() <= tol * z;
-  // Or the depth interpolated between the 4 nearest pixel centres when all 4 are surface
-  // (a surface seen at a grazing angle changes by more than 1% within one pixel).
-  const torch::Tensor fxs = torch::clamp(u - 0.5, 0.0, sw - 1.0);
-  const torch::Tensor fys = torch::clamp(v - 0.5, 0.0, sh - 1.0);
-  const torch::Tensor x0 = torch::clamp_max(fxs.floor(), std::max<int64_t>(sw - 2, 0));
-  const torch::Tensor y0 = torch::clamp_max(fys.floor(), std::max<int64_t>(sh - 2, 0));
-  const torch::Tensor x1 = torch::clamp_max(x0 + 1, sw - 1),
-                      y1 = torch::clamp_max(y0 + 1, sh - 1);
-  const torch::Tensor ax = fxs - x0, ay = fys - y0;
-  const torch::Tensor d00 = GatherDepth(depths, sw, y0, x0),
-                      d10 = GatherDepth(depths, sw, y0, x1),
-                      d01 = GatherDepth(depths, sw, y1, x0),
-                      d11 = GatherDepth(depths, sw, y1, x1);
-  const torch::Tensor all_surface = (d00 > 0) & (d10 > 0) & (d01 > 0) & (d11 > 0);
-  const torch::Tensor bilinear =
-      (1 - ay) * ((1 - ax) * d00 + ax * d10) + ay * ((1 - ax) * d01 + ax * d11);
-  const torch::Tensor bilinear_ok = all_surface & ((z - bilinear).abs() <= tol * z);
-  return torch::where(surface, nearest_ok | bilinear_ok, sees_infinity);
-}
-
-// The sources as ULR sees them: centres in the target frame, -R_rel^T t_rel, and focal
-// lengths sqrt(fx fy) [K].
-UlrSources TrainingUlrSources(const torch::Tensor& R_rel, const torch::Tensor& t_rel,
-                              const torch::Tensor& focals, double target_focal) {
-  const torch::Tensor centers =
-      -torch::matmul(R_rel.transpose(1, 2), t_rel.unsqueeze(-1)).squeeze(-1);
-  UlrSources ulr;
-  ulr.target_focal = target_focal;
-  for (int64_t s = 0; s < centers.size(0); ++s) {
-    ulr.centers.emplace_back(centers[s][0].item<double>(), centers[s][1].item<double>(),
-                             centers[s][2].item<double>());
-    ulr.focals.push_back(focals[s].item<double>());
+// A camera of the packed set (K [3,3], R [3,3], t [3], any floating type) as the warp's
+// PinholeCamera (fx, fy, cx, cy of K).
+PinholeCamera TensorCamera(const torch::Tensor& K, const torch::Tensor& R,
+                           const torch::Tensor& t, int64_t width, int64_t height) {
+  const torch::Tensor k = K.to(torch::kDouble).cpu().contiguous();
+  const torch::Tensor r = R.to(torch::kDouble).cpu().contiguous();
+  const torch::Tensor tt = t.to(torch::kDouble).cpu().contiguous();
+  PinholeCamera camera;
+  camera.width = static_cast<int>(width);
+  camera.height = static_cast<int>(height);
+  camera.fx = DoubleAt(k, 0);
+  camera.cx = DoubleAt(k, 2);
+  camera.fy = DoubleAt(k, 4);
+  camera.cy = DoubleAt(k, 5);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) camera.R(i, j) = DoubleAt(r, 3 * i + j);
+    camera.t[i] = DoubleAt(tt, i);
   }
-  return ulr;
+  return camera;
 }
 
-// ULR log-weights [K, hw] (UlrLogWeights) at the target's points [hw,3]: surface points
-// as they are, the rays of pixels without a surface (surface [hw], bool) moved to
-// UlrPointAtInfinity as the renderer's UlrSurfacePoint does.
-torch::Tensor TrainingUlrLogWeights(const torch::Tensor& points,
-                                    const torch::Tensor& surface,
-                                    const UlrSources& sources,
+// A depth map [h, w] as a 1-channel Image.
+Image DepthImage(const torch::Tensor& depth) {
+  const torch::Tensor d = depth.to(torch::kFloat).cpu().contiguous();
+  Image image(static_cast<int>(d.size(1)), static_cast<int>(d.size(0)), 1);
+  std::memcpy(image.data.data(), d.data_ptr<float>(), image.data.size() * sizeof(float));
+  return image;
+}
+
+// ULR log-weights [K, hw] (UlrLogWeights) at the target's pixels: surface points at
+// their depth, the rays of pixels without a surface moved to UlrPointAtInfinity as the
+// renderer's UlrSurfacePoint does. The sources as ULR sees them: centres in the target
+// frame, -R_rel^T t_rel (relative poses as the warp's), focal lengths sqrt(fx fy).
+torch::Tensor TrainingUlrLogWeights(const PinholeCamera& target, const Image& target_depth,
+                                    const std::vector<PinholeCamera>& sources,
                                     const torch::Tensor& valid_warp,
                                     const UlrSettings& settings) {
-  const int64_t n = points.size(0), k = sources.size();
-  std::vector<double> pts(points.data_ptr<double>(), points.data_ptr<double>() + 3 * n);
-  const double far_distance = UlrFarDistance(sources);
-  const bool* is_surface = surface.data_ptr<bool>();
-  for (int64_t i = 0; i < n; ++i) {
-    if (is_surface[i]) continue;
-    const Eigen::Vector3d p = UlrPointAtInfinity(
-        Eigen::Vector3d(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]), far_distance);
-    for (int c = 0; c < 3; ++c) pts[3 * i + c] = p[c];
+  UlrSources ulr;
+  ulr.target_focal = std::sqrt(target.fx * target.fy);
+  for (const PinholeCamera& source : sources) {
+    const Eigen::Matrix3d R_rel = source.R * target.R.transpose();
+    const Eigen::Vector3d t_rel = source.t - R_rel * target.t;
+    ulr.centers.push_back(-(R_rel.transpose() * t_rel));
+    ulr.focals.push_back(std::sqrt(source.fx * source.fy));
+  }
+  const int w = target.width, h = target.height;
+  const int64_t n = static_cast<int64_t>(w) * h, k = ulr.size();
+  const double far_distance = UlrFarDistance(ulr);
+  std::vector<double> points(3 * n);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int64_t i = static_cast<int64_t>(y) * w + x;
+      const float raw = target_depth.data[i];
+      const bool surface = raw > 0 && std::isfinite(raw);
+      const double d = surface ? raw : 1.0;
+      Eigen::Vector3d p((x + 0.5 - target.cx) / target.fx * d,
+                        (y + 0.5 - target.cy) / target.fy * d, d);
+      if (!surface) p = UlrPointAtInfinity(p, far_distance);
+      for (int c = 0; c < 3; ++c) points[3 * i + c] = p[c];
+    }
   }
   const torch::Tensor sees = valid_warp.reshape({k, n}).contiguous();
   torch::Tensor log_weights = torch::empty({k, n}, torch::kFloat);
-  UlrLogWeights(pts.data(), n, sources, sees.data_ptr<float>(), settings,
+  UlrLogWeights(points.data(), n, ulr, sees.data_ptr<float>(), settings,
                 log_weights.data_ptr<float>(), /*num_threads=*/1);
   return log_weights;
 }
@@ -226,83 +212,46 @@ TrainingWarp ComputeTrainingWarp(
     const torch::Tensor& source_K, const torch::Tensor& source_R,
     const torch::Tensor& source_t, const torch::Tensor& source_depths,
     const WarpSettings& settings) {
-  using torch::indexing::Slice;
-  const auto f64 = torch::TensorOptions().dtype(torch::kDouble);
   const int64_t h = target_depth.size(0), w = target_depth.size(1);
   const int64_t k = source_K.size(0), sh = source_depths.size(1),
                 sw = source_depths.size(2);
-
-  // Target rays through the pixel centres, in double.
-  const torch::Tensor Kt = target_K.to(torch::kDouble).cpu();
-  const double fx = Kt[0][0].item<double>(), fy = Kt[1][1].item<double>();
-  const double cx = Kt[0][2].item<double>(), cy = Kt[1][2].item<double>();
-  const torch::Tensor xs = (torch::arange(w, f64) + 0.5 - cx) / fx;
-  const torch::Tensor ys = (torch::arange(h, f64) + 0.5 - cy) / fy;
-  const torch::Tensor raw = target_depth.to(torch::kDouble).cpu();
-  const torch::Tensor surface = (raw > 0) & torch::isfinite(raw);
-  const torch::Tensor surface_flat = surface.reshape({1, h * w});
-  // Surface pixels at their depth; the others as their ray (x, y, 1), warped at
-  // infinity: rotated, never translated (scene/warp.h).
-  const torch::Tensor depth = torch::where(surface, raw, torch::ones_like(raw));
-  const torch::Tensor points =
-      torch::stack({xs.unsqueeze(0).expand({h, w}) * depth,
-                    ys.unsqueeze(1).expand({h, w}) * depth, depth},
-                   -1)
-          .reshape({1, h * w, 3});
-
-  // Relative poses R_k R_t^T, t_k - R_rel t_t: absolute translations never meet floats.
-  const torch::Tensor Rt = target_R.to(torch::kDouble).cpu();
-  const torch::Tensor tt = target_t.to(torch::kDouble).cpu();
-  const torch::Tensor Rs = source_R.to(torch::kDouble).cpu();
-  const torch::Tensor R_rel = torch::matmul(Rs, Rt.t());  // [K,3,3]
-  const torch::Tensor t_rel =
-      source_t.to(torch::kDouble).cpu() -
-      torch::matmul(R_rel, tt.reshape({3, 1})).squeeze(-1);  // [K,3]
-  const torch::Tensor translated = surface_flat.unsqueeze(-1).to(torch::kDouble);
-  const torch::Tensor X = torch::matmul(points, R_rel.transpose(1, 2)) +
-                          t_rel.unsqueeze(1) * translated;  // [K,hw,3]
-  const torch::Tensor z = X.select(2, 2);
-  const torch::Tensor norm = X.norm(2, 2);
-  const torch::Tensor in_front = z > 1e-12 * torch::clamp_min(norm, 1.0);
-  const torch::Tensor Ks = source_K.to(torch::kDouble).cpu();
-  const torch::Tensor sfx = Ks.index({Slice(), 0, 0}).unsqueeze(1);
-  const torch::Tensor sfy = Ks.index({Slice(), 1, 1}).unsqueeze(1);
-  const torch::Tensor scx = Ks.index({Slice(), 0, 2}).unsqueeze(1);
-  const torch::Tensor scy = Ks.index({Slice(), 1, 2}).unsqueeze(1);
-  const torch::Tensor safe_z = torch::where(in_front, z, torch::ones_like(z));
-  torch::Tensor u = sfx * X.select(2, 0) / safe_z + scx;
-  torch::Tensor v = sfy * X.select(2, 1) / safe_z + scy;
-  const torch::Tensor projects = in_front & torch::isfinite(u) & torch::isfinite(v);
-  // As the CPU warp: far-off coordinates stay finite and clearly outside; no projection
-  // -> (-1, -1).
-  const double lim = 1e7 + 4.0 * std::max(sw, sh);
-  u = torch::where(projects, torch::clamp(torch::nan_to_num(u), -lim, lim),
-                   torch::full_like(u, -1.0));
-  v = torch::where(projects, torch::clamp(torch::nan_to_num(v), -lim, lim),
-                   torch::full_like(v, -1.0));
-  const torch::Tensor inside = projects & (u >= 0) & (v >= 0) & (u < sw) & (v < sh);
-  const torch::Tensor sd = source_depths.to(torch::kDouble).cpu().reshape({k, sh * sw});
-  torch::Tensor valid =
-      inside & SourceSees(sd, sw, sh, u, v, z, surface_flat.expand({k, h * w}), settings);
-  if (!settings.inf_depth) {
-    valid = valid & surface_flat;
-    u = torch::where(surface_flat, u, torch::full_like(u, -1.0));
-    v = torch::where(surface_flat, v, torch::full_like(v, -1.0));
-  }
+  const PinholeCamera target = TensorCamera(target_K, target_R, target_t, w, h);
+  const Image depth = DepthImage(target_depth);
+  WarpOptions options;
+  options.occlusion_tolerance = settings.occlusion_tolerance;
+  options.invalid_depth = settings.invalid_depth;
+  options.at_infinity = settings.inf_depth;
 
   TrainingWarp out;
-  out.grid = torch::stack({2.0 * u / sw - 1.0, 2.0 * v / sh - 1.0}, -1)
-                 .reshape({k, h, w, 2})
-                 .to(torch::kFloat);
-  out.valid_depth = surface.to(torch::kFloat).reshape({1, 1, h, w});
-  out.valid_warp = valid.to(torch::kFloat).reshape({k, 1, h, w});
+  out.grid = torch::empty({k, h, w, 2}, torch::kFloat);
+  out.valid_depth = torch::empty({1, 1, h, w}, torch::kFloat);
+  out.valid_warp = torch::empty({k, 1, h, w}, torch::kFloat);
+  const size_t n = static_cast<size_t>(h * w);
+  std::vector<PinholeCamera> sources;
+  for (int64_t s = 0; s < k; ++s) {
+    sources.push_back(TensorCamera(source_K[s], source_R[s], source_t[s], sw, sh));
+    // The warp in double from the relative poses (geometry/warp.h), the renderer's.
+    const WarpMap map =
+        ComputeWarpMap(target, depth, sources.back(), DepthImage(source_depths[s]), options);
+    const Image grid =
+        GridSampleCoordinates(map, static_cast<int>(sw), static_cast<int>(sh));
+    std::memcpy(out.grid[s].data_ptr<float>(), grid.data.data(), 2 * n * sizeof(float));
+    std::memcpy(out.valid_warp[s].data_ptr<float>(), map.valid_warp.data.data(),
+                n * sizeof(float));
+    if (s == 0) {
+      std::memcpy(out.valid_depth.data_ptr<float>(), map.valid_depth.data.data(),
+                  n * sizeof(float));
+    }
+  }
+  if (k == 0) {
+    out.valid_depth.copy_(((target_depth > 0) & torch::isfinite(target_depth))
+                              .to(torch::kFloat)
+                              .reshape({1, 1, h, w}));
+  }
   if (settings.ulr_log_weights) {
-    const UlrSources ulr = TrainingUlrSources(
-        R_rel, t_rel, torch::sqrt(sfx * sfy).reshape({k}), std::sqrt(fx * fy));
-    out.ulr_log_weights = TrainingUlrLogWeights(points.reshape({h * w, 3}).contiguous(),
-                                                surface.reshape({h * w}).contiguous(),
-                                                ulr, out.valid_warp, settings.ulr)
-                              .reshape({k, 1, h, w});
+    out.ulr_log_weights =
+        TrainingUlrLogWeights(target, depth, sources, out.valid_warp, settings.ulr)
+            .reshape({k, 1, h, w});
   }
   return out;
 }

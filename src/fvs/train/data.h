@@ -1,8 +1,8 @@
 // The trainer's side of the packed training set (pack.h): loading a scene.safetensors
 // into tensors, leave-one-out source selection, the warp of a target crop into its
-// sources (grid_sample grid and masks, computed in double precision from the relative
-// poses), and the random sampler whose state a checkpoint stores. Reads only
-// util/safetensors + torch.
+// sources (grid_sample grid and masks: the renderer's warp, geometry/warp.h), and the
+// random sampler whose state a checkpoint stores. Reads only util/safetensors,
+// geometry/warp.h and torch.
 #pragma once
 
 #include <torch/torch.h>
@@ -46,7 +46,7 @@ std::vector<int> ValidationTargets(const PackedScene& scene, int count);
 
 struct WarpSettings {
   double occlusion_tolerance = 0.01;  // |z - D_source| <= tol * z
-  // No-surface target pixels warped at infinity (rotation only; scene/warp.h); false:
+  // No-surface target pixels warped at infinity (rotation only; geometry/warp.h); false:
   // they are invalid.
   bool inf_depth = true;
   double invalid_depth = 1e9;  // what a source pixel without a surface counts as
@@ -65,14 +65,14 @@ struct TrainingWarp {
 };
 
 // target_K/R/t: double [3,3], [3,3], [3]; target_depth float [h,w] (its camera's image
-// size); source_K/R/t: double [K,3,3], [K,3,3], [K,3]; source_depths float [K,H,W]. The
-// same conventions as fvs::ComputeWarpMap (scene/warp.h): pixel centres at +0.5; the
-// occlusion test passes with the source depth at the nearest source pixel (no surface =
-// invalid_depth) or, failing that, with the depth interpolated between the 4 nearest
-// pixel centres when all 4 are surface. Target pixels without a surface are warped at
-// infinity (rotation only, seen where the source has no surface either) when inf_depth,
-// else are invalid. The ULR log-weights weigh them at UlrPointAtInfinity, as the
-// renderer does.
+// size); source_K/R/t: double [K,3,3], [K,3,3], [K,3]; source_depths float [K,H,W].
+// This is fvs::ComputeWarpMap (geometry/warp.h), the renderer's warp, run per source
+// with these settings on the cameras and depths the tensors hold; its maps come back as
+// tensors: grid = GridSampleCoordinates of the map, the masks as they are. So training
+// and rendering warp alike by construction (pixel centres at +0.5, the occlusion test,
+// the relative poses in double precision). Target pixels without a surface are warped
+// at infinity when inf_depth, else are invalid (WarpOptions::at_infinity). The ULR
+// log-weights weigh them at UlrPointAtInfinity, as the renderer does.
 TrainingWarp ComputeTrainingWarp(
     const torch::Tensor& target_K, const torch::Tensor& target_R,
     const torch::Tensor& target_t, const torch::Tensor& target_depth,

@@ -1,5 +1,5 @@
 // A 64-bit content hash (FNV-1a over 8-byte words, then a splitmix64 finaliser) for cache
-// keys: which weights, which photo. Not cryptographic; fast (about 2 GB/s here).
+// keys: which weights, which photo. Not cryptographic; fast (one pass over 8-byte words).
 #pragma once
 
 #include <cstddef>

@@ -1,4 +1,4 @@
-#include "fvs/scene/warp.h"
+#include "fvs/geometry/warp.h"
 
 #include <algorithm>
 #include <cmath>
@@ -82,6 +82,11 @@ bool WarpPixel(const TargetRay& pixel, const Eigen::Matrix3d& R_rel,
                const Image& source_depth, const WarpOptions& options, size_t i,
                WarpMap* map) {
   const bool surface = pixel.depth > 0;
+  if (!surface && !options.at_infinity) {
+    map->source_xy.data[2 * i] = map->source_xy.data[2 * i + 1] = -1.f;
+    map->source_z.data[i] = map->valid_depth.data[i] = map->valid_warp.data[i] = 0.f;
+    return false;
+  }
   // At infinity only the direction counts: the rotation alone, no translation, and no
   // huge stand-in depth whose source Z would never match a stand-in source depth.
   const Eigen::Vector3d X =

@@ -1,4 +1,6 @@
 // Warping maps: where each target pixel lands in a source image, given the target depth.
+// The one warp of the project: the renderers (render/prepare.h), the trainer's samples
+// (train/data.h ComputeTrainingWarp), camera paths and the flicker metric all call it.
 // No torch here: the maps are plain float images that the renderers sample with
 // SampleBilinear and that the network feeds to grid_sample (GridSampleCoordinates).
 //
@@ -42,6 +44,9 @@ struct WarpOptions {
   // What a source pixel without a surface counts as in the occlusion test of a target
   // surface point: far beyond any real surface, so it never matches one.
   double invalid_depth = 1e9;
+  // Target pixels without a surface are warped at infinity (above); false: they are
+  // invalid (source_xy (-1, -1), valid_warp 0), the fvs_noinfdepth ablation.
+  bool at_infinity = true;
   int num_threads = 0;  // <= 0: DefaultNumThreads()
   void Check() const;
 };

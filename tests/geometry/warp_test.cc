@@ -1,7 +1,7 @@
 // Warping maps against a brute-force reference (unproject to world and project with the
 // absolute poses, in long double) on random cameras, near and far from the origin, and
 // the numerical edge cases (depth 0 / 1e30, behind, edge-on, extreme focal lengths).
-#include "fvs/scene/warp.h"
+#include "fvs/geometry/warp.h"
 
 #include <gtest/gtest.h>
 
@@ -301,6 +301,42 @@ TEST(WarpTest, SourceSurfaceOccludesTheBackground) {
     const double u = surface.source_xy.data[2 * i];
     if (u >= 20 && u < 40) EXPECT_EQ(surface.valid_warp.data[i], 0.f);
   }
+}
+
+// The fvs_noinfdepth ablation: pixels without a surface are invalid at (-1, -1); those
+// with one are warped exactly as with the default.
+TEST(WarpTest, WithoutInfinityTheBackgroundIsInvalid) {
+  const PinholeCamera target = SimpleCamera(40, 30, 36);
+  PinholeCamera source = target;
+  source.R = Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  source.t = Eigen::Vector3d(0.2, 0, 0);
+  Image target_depth(40, 30, 1, 3.f), source_depth(40, 30, 1, 0.f);
+  for (int x = 0; x < 40; ++x) {
+    for (int y = 0; y < 10; ++y) target_depth.at(x, y) = 0.f;  // sky in the top rows
+    for (int y = 10; y < 30; ++y) source_depth.at(x, y) = 3.f;
+  }
+  WarpOptions no_infinity;
+  no_infinity.at_infinity = false;
+  const WarpMap with = ComputeWarpMap(target, target_depth, source, source_depth);
+  const WarpMap without =
+      ComputeWarpMap(target, target_depth, source, source_depth, no_infinity);
+  int64_t sky_seen = 0;
+  for (size_t i = 0; i < with.valid_warp.data.size(); ++i) {
+    if (target_depth.data[i] > 0) {
+      EXPECT_EQ(without.source_xy.data[2 * i], with.source_xy.data[2 * i]);
+      EXPECT_EQ(without.source_xy.data[2 * i + 1], with.source_xy.data[2 * i + 1]);
+      EXPECT_EQ(without.valid_warp.data[i], with.valid_warp.data[i]);
+      EXPECT_EQ(without.source_z.data[i], with.source_z.data[i]);
+    } else {
+      sky_seen += with.valid_warp.data[i] > 0;
+      EXPECT_EQ(without.source_xy.data[2 * i], -1.f);
+      EXPECT_EQ(without.source_xy.data[2 * i + 1], -1.f);
+      EXPECT_EQ(without.valid_warp.data[i], 0.f);
+      EXPECT_EQ(without.valid_depth.data[i], 0.f);
+    }
+  }
+  EXPECT_GT(sky_seen, 0);  // the default does see the sky
+  EXPECT_EQ(without.num_valid, with.num_valid - sky_seen);
 }
 
 TEST(WarpTest, BackgroundAtExtremePosesStaysFinite) {
