@@ -26,24 +26,6 @@ bool IsNetworkMethod(const std::string& method) {
 
 }  // namespace
 
-std::vector<int> ParseIntList(const std::string& list, const std::string& option) {
-  std::vector<int> values;
-  for (const std::string& item : Items(list)) {
-    size_t used = 0;
-    int v = 0;
-    try {
-      v = std::stoi(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    Require(used == item.size() && v >= 1, option,
-            "'" + item + "' is not a positive integer");
-    values.push_back(v);
-  }
-  Require(!values.empty(), option, "empty list");
-  return values;
-}
-
 std::vector<double> ParseDoubleList(const std::string& list, const std::string& option) {
   std::vector<double> values;
   for (const std::string& item : Items(list)) {

@@ -31,8 +31,7 @@ struct SweepPlan {
 
 SweepPlan PlanSweep(const SweepOptions& options);
 
-// "1,2,3" -> {1,2,3}; throws fvs::Error(option, ...) for anything else.
-std::vector<int> ParseIntList(const std::string& list, const std::string& option);
+// "1,0.5" -> {1,0.5} (scales in (0, 4]); throws fvs::Error(option, ...) for anything else.
 std::vector<double> ParseDoubleList(const std::string& list, const std::string& option);
 
 // The variant named in a weights file's config (reads the file's header and metadata).
