@@ -12,6 +12,7 @@
 #include "fvs/scene/scene.h"
 #include "fvs/util/error.h"
 #include "fvs/util/machine.h"
+#include "fvs/util/parse_int.h"
 #include "fvs/util/progress.h"
 
 namespace fvs::eval {
@@ -64,14 +65,8 @@ std::string FormatNumSources(int num_sources) {
 
 int ParseNumSources(const std::string& text, const std::string& where) {
   if (text == "auto") return 0;
-  size_t used = 0;
   int k = 0;
-  try {
-    k = std::stoi(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  Require(used == text.size() && k >= 1, where,
+  Require(ParsePositiveInt(text, &k), where,
           "'" + text + "' is not a number of sources (a positive integer or auto)");
   return k;
 }

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "fvs/util/error.h"
+#include "fvs/util/parse_int.h"
 #include "fvs/util/string_util.h"
 
 namespace fvs {
@@ -175,7 +176,8 @@ void TrainOptions::Check() const {
           "--Train.precision must be fp32 or bf16, not '" + precision +
               "' (fp16 training would need loss scaling)");
   if (benchmark) {
-    Require(!val_scene_list.empty(), kSubject, "--Train.benchmark needs --val_scene_list");
+    Require(!val_scene_list.empty(), kSubject,
+            "--Train.benchmark needs --val_scene_list");
     Require(bench_seconds > 0, kSubject, "--Train.bench_seconds must be positive");
     Require(bench_views >= 1, kSubject, "--Train.bench_views must be at least 1");
     ParseBenchmarkGrid(*this);  // throws on a malformed list
@@ -194,14 +196,8 @@ BenchmarkGrid ParseBenchmarkGrid(const TrainOptions& o) {
     return items;
   };
   auto to_int = [](const std::string& s, const std::string& what) {
-    size_t used = 0;
     int v = 0;
-    try {
-      v = std::stoi(s, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    Require(used == s.size() && v >= 1, kSubject,
+    Require(ParsePositiveInt(s, &v), kSubject,
             what + ": '" + s + "' is not a positive whole number");
     return v;
   };
