@@ -1,7 +1,8 @@
 // colmap view_synthesis_mesher --workspace_path W [--output_path W/meshed-delaunay.ply]
 //
 // The built-in Delaunay graph-cut mesher (src/fvs/mvs/delaunay.h) on a COLMAP dense
-// workspace: W/fused.ply + W/fused.ply.vis + W/sparse -> W/meshed-delaunay.ply, with the
+// workspace: W/fused.ply + W/fused.ply.vis + W/sparse (its SfM points too, see
+// --DelaunayMeshing.sparse_min_track_length) -> W/meshed-delaunay.ply, with the
 // options of COLMAP's delaunay_mesher (--DelaunayMeshing.*, same names and defaults), for
 // the COLMAP builds that lack CGAL (Debian's). Bad input: one error line, exit 1, no
 // output.
@@ -57,6 +58,12 @@ int RunViewSynthesisMesher(int argc, char** argv) {
                      &o.max_side_spacing_factor,
                      "not in COLMAP: drop faces longer than this factor times the local "
                      "point spacing at their vertices (0: off)");
+  options.AddDefault("DelaunayMeshing.sparse_min_track_length",
+                     &o.sparse_min_track_length,
+                     "not in COLMAP: add the SfM points seen by at least this many fused "
+                     "images (stereo/fusion.cfg; 0: fused points only)");
+  options.AddDefault("DelaunayMeshing.sparse_max_error", &o.sparse_max_error,
+                     "... whose reprojection error is at most this many pixels");
   options.AddDefault("DelaunayMeshing.num_threads", &o.num_threads,
                      "threads (-1: all cores)");
   if (!options.Parse(argc, argv)) return 0;

@@ -744,7 +744,11 @@ TriangleMesh DelaunayMeshing(const DelaunayMeshingInput& input,
   isolated_options.num_neighbors = options.isolated_point_neighbors;
   isolated_options.factor = options.isolated_point_factor;
   isolated_options.num_threads = options.num_threads;
-  const std::vector<bool> isolated = FindIsolatedPoints(input.points, isolated_options);
+  // Only the fused points are tested; the SfM points after them are kept (delaunay.h).
+  const size_t num_fused = input.points.size() - input.num_sparse_points;
+  std::vector<bool> isolated = FindIsolatedPoints(
+      {input.points.begin(), input.points.begin() + num_fused}, isolated_options);
+  isolated.resize(input.points.size(), false);
   const size_t num_isolated = std::count(isolated.begin(), isolated.end(), true);
   DelaunayMeshingInput kept;
   if (num_isolated > 0) {
@@ -762,6 +766,7 @@ TriangleMesh DelaunayMeshing(const DelaunayMeshingInput& input,
   TriangleMesh mesh = mesher.Run(stats);
   stats->num_input_points = input.points.size();
   stats->num_isolated_points = num_isolated;
+  stats->num_sparse_points = input.num_sparse_points;
   for (const auto& v : mesh.vertices) {
     Require(v.allFinite(), input.points_subject,
             "non-finite mesh vertex (internal error)");

@@ -83,6 +83,16 @@ struct DelaunayMeshingOptions {
   // that bridge empty space between parts of the cloud fail it; faces in sparse regions,
   // or joining a sparse region to a dense one, do not. 0 = off, as COLMAP.
   double max_side_spacing_factor = 10.0;
+  // Not in COLMAP: the SfM points of W/sparse join the fused points, with their tracks as
+  // visibility, when at least sparse_min_track_length of the fused images (those listed
+  // in W/stereo/fusion.cfg, so photos held out of the geometry never count) see them
+  // and their reprojection error is at most sparse_max_error pixels. Stereo leaves
+  // textureless floors, white walls and far backgrounds without confirmed depth
+  // (doc/real_scenes.md), where SfM often has features. They skip the isolated-point
+  // filter: SfM's track and error tests already confirmed them, and the background they
+  // add is sparse by nature. 0 = fused points only, as COLMAP.
+  int sparse_min_track_length = 2;
+  double sparse_max_error = 2.0;
   // <= 0: DefaultNumThreads() (COLMAP uses -1 for "all").
   int num_threads = -1;
 
@@ -97,6 +107,9 @@ struct DelaunayMeshingInput {
   std::vector<std::vector<uint32_t>> visibility;
   // Projection is used for point merging (max_proj_dist), the centre for the rays.
   std::vector<PinholeCamera> cameras;
+  // The last num_sparse_points of `points` are SfM points (exempt from the isolated-point
+  // filter).
+  size_t num_sparse_points = 0;
   // Names of the inputs, for error messages.
   std::string points_subject = "points";
   std::string visibility_subject = "visibility";
@@ -108,6 +121,7 @@ struct DelaunayMeshingInput {
 
 struct DelaunayMeshingStats {
   size_t num_input_points = 0;
+  size_t num_sparse_points = 0;     // SfM points among the input points
   size_t num_isolated_points = 0;   // dropped before triangulation
   size_t num_vertices = 0;          // triangulation vertices (after merging)
   size_t num_cells = 0;             // including infinite cells
@@ -142,8 +156,10 @@ TriangleMesh DelaunayMeshing(const DelaunayMeshingInput& input,
 // builds in the order the images appear in images.bin / images.txt (not sorted by id: 3.8
 // writes images in hash-map order); this reader keeps that file order. Throws fvs::Error
 // on a missing or bad file, an empty cloud, or a vis file that does not match the ply
-// (count or image index).
-DelaunayMeshingInput ReadDenseMeshingInput(const std::string& workspace_path);
+// (count or image index). Appends the SfM points that options.sparse_min_track_length
+// and sparse_max_error admit (no fusion.cfg: every registered image counts as fused).
+DelaunayMeshingInput ReadDenseMeshingInput(const std::string& workspace_path,
+                                           const DelaunayMeshingOptions& options = {});
 
 // The image ids of <sparse_dir>/images.bin (or images.txt) in file order.
 std::vector<uint32_t> ReadImageIdsInFileOrder(const std::string& sparse_dir);

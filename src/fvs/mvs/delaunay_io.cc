@@ -3,9 +3,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include "colmap_ext/dense_io.h"
+#include "colmap_ext/reconstruction.h"
 #include "colmap_ext/sparse_io.h"
 #include "colmap_ext/workspace.h"
 #include "fvs/geometry/ply.h"
@@ -76,6 +79,47 @@ std::vector<uint32_t> ReadImageIdsText(const std::string& path) {
   return ids;
 }
 
+
+// The names in a COLMAP fusion.cfg (one image name per line; blank lines skipped).
+std::set<std::string> ReadFusionImageNames(const std::string& path) {
+  std::ifstream file(path);
+  Require(file.good(), path, "cannot open");
+  std::set<std::string> names;
+  std::string line;
+  while (std::getline(file, line)) {
+    line = TrimString(line);
+    if (!line.empty()) names.insert(line);
+  }
+  return names;
+}
+
+// Appends the SfM points of `reconstruction` that `options` admits, their visibility
+// restricted to the fused images (positions in `order`).
+void AppendSparsePoints(const colmap::Reconstruction& reconstruction,
+                        const std::vector<uint32_t>& order,
+                        const std::set<std::string>* fused_names,
+                        const DelaunayMeshingOptions& options,
+                        DelaunayMeshingInput* input) {
+  if (options.sparse_min_track_length <= 0) return;
+  std::map<uint32_t, uint32_t> index_of;  // image id -> position in `order`
+  for (size_t i = 0; i < order.size(); ++i) {
+    const std::string& name = reconstruction.images.at(order[i]).name;
+    if (!fused_names || fused_names->count(name)) index_of[order[i]] = i;
+  }
+  for (const auto& [id, point] : reconstruction.points3D) {
+    if (point.error > options.sparse_max_error || !point.xyz.allFinite()) continue;
+    std::set<uint32_t> seen;  // a track may hold one image twice
+    for (const colmap::TrackElement& el : point.track) {
+      const auto it = index_of.find(el.image_id);
+      if (it != index_of.end()) seen.insert(it->second);
+    }
+    if (static_cast<int>(seen.size()) < options.sparse_min_track_length) continue;
+    input->points.push_back(point.xyz);
+    input->visibility.emplace_back(seen.begin(), seen.end());
+    ++input->num_sparse_points;
+  }
+}
+
 }  // namespace
 
 void DelaunayMeshingOptions::Check() const {
@@ -98,6 +142,10 @@ void DelaunayMeshingOptions::Check() const {
   require(num_threads >= -1, "num_threads must be -1 (all), 0 (all) or positive");
   require(std::isfinite(max_side_spacing_factor) && max_side_spacing_factor >= 0,
           "max_side_spacing_factor must be >= 0, not " + Num(max_side_spacing_factor));
+  require(sparse_min_track_length >= 0, "sparse_min_track_length must be >= 0, not " +
+                                            std::to_string(sparse_min_track_length));
+  require(std::isfinite(sparse_max_error) && sparse_max_error > 0,
+          "sparse_max_error must be > 0, not " + Num(sparse_max_error));
   IsolatedPointOptions isolated;
   isolated.num_neighbors = isolated_point_neighbors;
   isolated.factor = isolated_point_factor;
@@ -109,6 +157,8 @@ void DelaunayMeshingInput::Check() const {
   Require(points.size() >= 4, points_subject,
           "only " + std::to_string(points.size()) +
               " points: a volume needs at least 4 (degenerate point cloud)");
+  Require(num_sparse_points <= points.size(), kWho,
+          "more SfM points than points (internal error)");
   Require(visibility.size() == points.size(), visibility_subject,
           "has " + std::to_string(visibility.size()) +
               " points but the point cloud has " + std::to_string(points.size()) +
@@ -136,12 +186,12 @@ std::string DelaunayMeshingStats::Summary() const {
   char buffer[512];
   std::snprintf(
       buffer, sizeof(buffer),
-      "%zu points (%zu isolated dropped) -> %zu vertices, %zu cells, %zu rays (%.0f "
+      "%zu points (%zu from SfM; %zu isolated dropped) -> %zu vertices, %zu cells, %zu rays (%.0f "
       "steps each), %zu surface facets -> %zu "
       "faces (%zu dropped by local spacing), %zu vertices; time %.2f s (triangulation "
       "%.2f, visibility %.2f, "
       "graph cut %.2f, extraction %.2f)",
-      num_input_points, num_isolated_points, num_vertices, num_cells, num_rays,
+      num_input_points, num_sparse_points, num_isolated_points, num_vertices, num_cells, num_rays,
       num_rays ? static_cast<double>(num_ray_steps) / num_rays : 0.0, num_surface_facets,
       num_faces, num_spacing_filtered, num_mesh_vertices, seconds_total,
       seconds_triangulation, seconds_visibility, seconds_graph, seconds_extraction);
@@ -156,7 +206,8 @@ std::vector<uint32_t> ReadImageIdsInFileOrder(const std::string& sparse_dir) {
   throw Error(sparse_dir, "no images.bin or images.txt");
 }
 
-DelaunayMeshingInput ReadDenseMeshingInput(const std::string& workspace_path) {
+DelaunayMeshingInput ReadDenseMeshingInput(const std::string& workspace_path,
+                                           const DelaunayMeshingOptions& options) {
   const colmap::DenseWorkspace workspace(workspace_path);
   const std::string fused = workspace.FusedPath();
   const std::string vis = workspace.FusedVisPath();
@@ -187,6 +238,13 @@ DelaunayMeshingInput ReadDenseMeshingInput(const std::string& workspace_path) {
               std::to_string(reconstruction.images.size()));
   input.cameras.reserve(order.size());
   for (const uint32_t id : order) input.cameras.push_back(reconstruction.PinholeFor(id));
+  const std::string fusion_cfg = workspace.StereoDir() + "/fusion.cfg";
+  if (std::filesystem::exists(fusion_cfg)) {
+    const std::set<std::string> fused_names = ReadFusionImageNames(fusion_cfg);
+    AppendSparsePoints(reconstruction, order, &fused_names, options, &input);
+  } else {
+    AppendSparsePoints(reconstruction, order, nullptr, options, &input);
+  }
   input.Check();
   return input;
 }
@@ -196,7 +254,7 @@ DelaunayMeshingStats DenseDelaunayMeshing(const std::string& workspace_path,
                                           const DelaunayMeshingOptions& options) {
   options.Check();
   Timer timer;
-  const DelaunayMeshingInput input = ReadDenseMeshingInput(workspace_path);
+  const DelaunayMeshingInput input = ReadDenseMeshingInput(workspace_path, options);
   const double read_seconds = timer.Seconds();
   DelaunayMeshingStats stats;
   const TriangleMesh mesh = DelaunayMeshing(input, options, &stats);
