@@ -175,7 +175,8 @@ TEST(DelaunayMesherSparse, SfmPointsMeshWhatFusionMissed) {
   for (const auto& p : cloud.true_points) {
     if (objects.DistanceToSurface(p) < 0.05) object_points.push_back(p);
   }
-  const MeshAccuracy objects_before = EvaluateMesh(scene, fused_only, object_points, 0.05);
+  const MeshAccuracy objects_before =
+      EvaluateMesh(scene, fused_only, object_points, 0.05);
   const MeshAccuracy objects_after = EvaluateMesh(scene, with_sfm, object_points, 0.05);
   std::printf(
       "walls covered: %.3f fused only, %.3f with SfM points (face mean %.4f p90 %.4f); "

@@ -79,7 +79,6 @@ std::vector<uint32_t> ReadImageIdsText(const std::string& path) {
   return ids;
 }
 
-
 // The names in a COLMAP fusion.cfg (one image name per line; blank lines skipped).
 std::set<std::string> ReadFusionImageNames(const std::string& path) {
   std::ifstream file(path);
@@ -186,15 +185,17 @@ std::string DelaunayMeshingStats::Summary() const {
   char buffer[512];
   std::snprintf(
       buffer, sizeof(buffer),
-      "%zu points (%zu from SfM; %zu isolated dropped) -> %zu vertices, %zu cells, %zu rays (%.0f "
+      "%zu points (%zu from SfM; %zu isolated dropped) -> %zu vertices, %zu cells, %zu "
+      "rays (%.0f "
       "steps each), %zu surface facets -> %zu "
       "faces (%zu dropped by local spacing), %zu vertices; time %.2f s (triangulation "
       "%.2f, visibility %.2f, "
       "graph cut %.2f, extraction %.2f)",
-      num_input_points, num_sparse_points, num_isolated_points, num_vertices, num_cells, num_rays,
-      num_rays ? static_cast<double>(num_ray_steps) / num_rays : 0.0, num_surface_facets,
-      num_faces, num_spacing_filtered, num_mesh_vertices, seconds_total,
-      seconds_triangulation, seconds_visibility, seconds_graph, seconds_extraction);
+      num_input_points, num_sparse_points, num_isolated_points, num_vertices, num_cells,
+      num_rays, num_rays ? static_cast<double>(num_ray_steps) / num_rays : 0.0,
+      num_surface_facets, num_faces, num_spacing_filtered, num_mesh_vertices,
+      seconds_total, seconds_triangulation, seconds_visibility, seconds_graph,
+      seconds_extraction);
   return buffer;
 }
 
