@@ -8,7 +8,9 @@
 # every 5th photo held out of the geometry (--holdout_images), the protocol of
 # view_synthesis_eval --protocol holdout; their packs are what the trainer validates on
 # (it skips the held-out views, which are kept for the reported evaluation).
-# FVS_TRAIN_STEPS (default 200000) and FVS_PREPARE_ONLY=1 steer it.
+# FVS_TRAIN_STEPS (default 200000), FVS_RUN (the run folder under runs/, default fvs_agg),
+# FVS_INIT (weights a new run starts from; a run with checkpoints resumes from them) and
+# FVS_PREPARE_ONLY=1 steer it.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 DATASETS="$(realpath "${1:-../shared/datasets}")"
@@ -89,7 +91,8 @@ ls -d packed/*/ | sed 's#/$##' | grep -v -e middlebury_temple -e /fox -e /monstr
 exec nice -n "$NICE" env FVS_NUM_THREADS="${FVS_NUM_THREADS:-$(nproc)}" \
   OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-PASSIVE}" FVS_LPIPS_PATH="$LPIPS" \
   bin/colmap view_synthesis_train \
-  --scene_list train.txt --val_scene_list val.txt --output_path runs/fvs_agg \
+  --scene_list train.txt --val_scene_list val.txt --output_path "runs/${FVS_RUN:-fvs_agg}" \
+  ${FVS_INIT:+--Train.init_weights "$FVS_INIT"} \
   --Train.variant fvs_agg --Train.crop 128 --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
   --Train.batch_size 4 --Train.learning_rate "${FVS_LR:-2e-4}" --Train.val_every 250 \
   --Train.val_views 4 --Train.log_every 25 --Train.checkpoint_minutes 10 --Train.loss "$LOSS"
