@@ -1,5 +1,6 @@
 #include "fvs/net/model_config.h"
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -27,84 +28,77 @@ void Read(const nlohmann::json& json, const char* key, T* value) {
   }
 }
 
-}  // namespace
+// Every variant once: its name and how it differs from the default (the paper's `fvs`).
+struct Variant {
+  const char* name;
+  void (*apply)(ModelConfig* c);
+};
 
-std::vector<std::string> ModelConfig::KnownVariants() {
-  return {"fvs", "fvs_nogru", "fvs_nomasks", "fvs_noinfdepth", "fvs_single", "fvs_fast",
-          "fvs_agg"};
-}
-
-ModelConfig ModelConfig::ForVariant(const std::string& name) {
-  ModelConfig c;
-  c.variant = name;
-  if (name == "fvs") {
-  } else if (name == "fvs_nogru") {
-    c.use_gru = false;
-  } else if (name == "fvs_nomasks") {
-    c.use_masks = false;
-  } else if (name == "fvs_noinfdepth") {
-    c.inf_depth = false;
-  } else if (name == "fvs_single") {
-    c.soft_argmax = false;
-  } else if (name == "fvs_fast") {
+const Variant kVariants[] = {
+    {"fvs", [](ModelConfig*) {}},
+    {"fvs_nogru", [](ModelConfig* c) { c->use_gru = false; }},
+    {"fvs_nomasks", [](ModelConfig* c) { c->use_masks = false; }},
+    {"fvs_noinfdepth", [](ModelConfig* c) { c->inf_depth = false; }},
+    {"fvs_single", [](ModelConfig* c) { c->soft_argmax = false; }},
     // For CPUs, about 20x fewer FLOPs than fvs per source: 32 feature channels, one conv
     // less in the encoder's first two stages, a blending U-Net of widths 16/24/32/48 with
     // two convs per stage (conv + ConvGRU). Still recurrent at every level, with
     // per-source confidences. The blend widths grow slowly with depth because a stage
-    // costs width^2 / 4^level: doubling per level (16/32/64/128) made every level cost
-    // the same, 4x the full-resolution one in all, for 33 GFLOPs per source at 480x270;
-    // these widths cost 18. Dense convs on purpose: LibTorch 1.13's CPU depthwise convs
-    // are slow, slower per FLOP by far than dense ones (doc/network.md has the timings);
-    // depthwise_separable stays available for GPUs.
-    c.feature_channels = 32;
-    c.encoder_channels = {32, 64, 128};
-    c.encoder_convs = {1, 1, 2};
-    c.blend_channels = {16, 24, 32, 48};
-    c.blend_convs_per_stage = 2;
-    c.depthwise_separable = false;
-    // Trains on a CPU in hours rather than weeks: it starts as the ULR blend of the
+    // costs width^2 / 4^level (doc/network.md has the FLOPs and timings). Dense convs on
+    // purpose: LibTorch 1.13's CPU depthwise convs are slower per FLOP by far;
+    // depthwise_separable stays available for GPUs. It starts as the ULR blend of the
     // sources that see a pixel and learns confidences and corrections from there.
-    c.rgb_skip = true;
-    c.ulr_prior = 1.0;
-  } else if (name == "fvs_agg") {
-    // Trains at tens of samples a second on a 2-core CPU: no encoder (the paper's
-    // ablation without one loses little), statistics across the warped sources instead
-    // of a recurrence, starts as the ULR blend (net/aggregate.h).
-    c.blender = "aggregate";
-    c.feature_channels = 0;
-    c.encoder_channels = {};
-    c.encoder_convs = {};
-    c.blend_channels = {16, 24};
-    c.blend_convs_per_stage = 1;
-    c.use_gru = false;
-    c.rgb_skip = true;
-    c.ulr_prior = 1.0;
-  } else {
-    throw Error(kSubject, "unknown network variant '" + name +
-                              "' (known: " + JoinNames(KnownVariants()) + ")");
+    {"fvs_fast",
+     [](ModelConfig* c) {
+       c->feature_channels = 32;
+       c->encoder_channels = {32, 64, 128};
+       c->encoder_convs = {1, 1, 2};
+       c->blend_channels = {16, 24, 32, 48};
+       c->blend_convs_per_stage = 2;
+       c->depthwise_separable = false;
+       c->rgb_skip = true;
+       c->ulr_prior = 1.0;
+     }},
+    // Trains at samples a second on a 2-core CPU: no encoder (the paper's ablation
+    // without one loses little), statistics across the warped sources instead of a
+    // recurrence, starts as the ULR blend (net/aggregate.h).
+    {"fvs_agg",
+     [](ModelConfig* c) {
+       c->blender = "aggregate";
+       c->feature_channels = 0;
+       c->encoder_channels = {};
+       c->encoder_convs = {};
+       c->blend_channels = {16, 24};
+       c->blend_convs_per_stage = 1;
+       c->use_gru = false;
+       c->rgb_skip = true;
+       c->ulr_prior = 1.0;
+     }},
+};
+
+}  // namespace
+
+std::vector<std::string> ModelConfig::KnownVariants() {
+  std::vector<std::string> names;
+  for (const Variant& v : kVariants) names.push_back(v.name);
+  return names;
+}
+
+ModelConfig ModelConfig::ForVariant(const std::string& name) {
+  for (const Variant& v : kVariants) {
+    if (name != v.name) continue;
+    ModelConfig c;
+    c.variant = name;
+    v.apply(&c);
+    return c;
   }
-  return c;
+  throw Error(kSubject, "unknown network variant '" + name +
+                            "' (known: " + JoinNames(KnownVariants()) + ")");
 }
 
 std::string ModelConfig::ToJson() const {
   nlohmann::ordered_json j;
-  j["variant"] = variant;
-  j["blender"] = blender;
-  j["feature_channels"] = feature_channels;
-  j["use_masks"] = use_masks;
-  j["use_gru"] = use_gru;
-  j["soft_argmax"] = soft_argmax;
-  j["inf_depth"] = inf_depth;
-  j["encoder_channels"] = encoder_channels;
-  j["encoder_convs"] = encoder_convs;
-  j["blend_channels"] = blend_channels;
-  j["blend_convs_per_stage"] = blend_convs_per_stage;
-  j["depthwise_separable"] = depthwise_separable;
-  j["rgb_skip"] = rgb_skip;
-  j["mask_prior"] = mask_prior;
-  j["ulr_prior"] = ulr_prior;
-  j["ulr_num_blend"] = ulr_num_blend;
-  j["ulr_resolution_weight"] = ulr_resolution_weight;
+  ForEachField(*this, [&](const char* name, const auto& value) { j[name] = value; });
   return j.dump();
 }
 
@@ -120,45 +114,16 @@ ModelConfig ModelConfig::FromJson(const std::string& text) {
     throw Error(kSubject, "no \"variant\" string");
   }
   // A misspelt field would silently build the default network: refuse it.
-  static const char* const kFields[] = {"variant",
-                                        "blender",
-                                        "feature_channels",
-                                        "use_masks",
-                                        "use_gru",
-                                        "soft_argmax",
-                                        "inf_depth",
-                                        "encoder_channels",
-                                        "encoder_convs",
-                                        "blend_channels",
-                                        "blend_convs_per_stage",
-                                        "depthwise_separable",
-                                        "rgb_skip",
-                                        "mask_prior",
-                                        "ulr_prior",
-                                        "ulr_num_blend",
-                                        "ulr_resolution_weight"};
+  std::vector<std::string> fields;
+  const ModelConfig defaults;
+  ForEachField(defaults, [&](const char* name, const auto&) { fields.push_back(name); });
   for (auto it = j.begin(); it != j.end(); ++it) {
-    bool known = false;
-    for (const char* field : kFields) known = known || it.key() == field;
-    if (!known) throw Error(kSubject, "unknown field \"" + it.key() + "\"");
+    if (std::find(fields.begin(), fields.end(), it.key()) == fields.end()) {
+      throw Error(kSubject, "unknown field \"" + it.key() + "\"");
+    }
   }
   ModelConfig c = ForVariant(j["variant"].get<std::string>());
-  Read(j, "blender", &c.blender);
-  Read(j, "feature_channels", &c.feature_channels);
-  Read(j, "use_masks", &c.use_masks);
-  Read(j, "use_gru", &c.use_gru);
-  Read(j, "soft_argmax", &c.soft_argmax);
-  Read(j, "inf_depth", &c.inf_depth);
-  Read(j, "encoder_channels", &c.encoder_channels);
-  Read(j, "encoder_convs", &c.encoder_convs);
-  Read(j, "blend_channels", &c.blend_channels);
-  Read(j, "blend_convs_per_stage", &c.blend_convs_per_stage);
-  Read(j, "depthwise_separable", &c.depthwise_separable);
-  Read(j, "rgb_skip", &c.rgb_skip);
-  Read(j, "mask_prior", &c.mask_prior);
-  Read(j, "ulr_prior", &c.ulr_prior);
-  Read(j, "ulr_num_blend", &c.ulr_num_blend);
-  Read(j, "ulr_resolution_weight", &c.ulr_resolution_weight);
+  ForEachField(c, [&](const char* name, auto& value) { Read(j, name, &value); });
   c.Check();
   return c;
 }

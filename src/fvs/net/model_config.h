@@ -10,7 +10,7 @@
 namespace fvs {
 
 struct ModelConfig {
-  // fvs | fvs_nogru | fvs_nomasks | fvs_noinfdepth | fvs_single | fvs_fast | fvs_agg
+  // One of KnownVariants() (the table in model_config.cc).
   std::string variant = "fvs";
   // "unet": the paper's recurrent blending U-Net over encoded features. "aggregate":
   // no encoder, per-pixel statistics across the warped photos and narrow convs
@@ -26,8 +26,8 @@ struct ModelConfig {
   // Per-source RGB + confidence, softmax over sources. false: one RGB head on the final
   // state.
   bool soft_argmax = true;
-  // Pixels without target depth are warped at infinity (geometry/warp.h); false: they have
-  // no valid warp.
+  // Pixels without target depth are warped at infinity (geometry/warp.h); false: they
+  // have no valid warp.
   bool inf_depth = true;
   // Encoder: VGG16 stage widths and conv counts (stages 1-3); decoder mirrors the widths.
   // Empty: no encoder (the photos' colours are warped as they are).
@@ -81,6 +81,30 @@ struct ModelConfig {
     return encoder_channels.empty() ? 1 : 1 << (encoder_channels.size() - 1);
   }
   int BlendStride() const { return 1 << (blend_channels.size() - 1); }
+
+  // Calls visit(json_name, field) for every field above, in the order of the JSON.
+  // ToJson, FromJson and its refusal of unknown names are built on it, so a new field is
+  // its declaration above plus one line here. (Self: ModelConfig or const ModelConfig.)
+  template <typename Self, typename Visit>
+  static void ForEachField(Self& c, Visit&& visit) {
+    visit("variant", c.variant);
+    visit("blender", c.blender);
+    visit("feature_channels", c.feature_channels);
+    visit("use_masks", c.use_masks);
+    visit("use_gru", c.use_gru);
+    visit("soft_argmax", c.soft_argmax);
+    visit("inf_depth", c.inf_depth);
+    visit("encoder_channels", c.encoder_channels);
+    visit("encoder_convs", c.encoder_convs);
+    visit("blend_channels", c.blend_channels);
+    visit("blend_convs_per_stage", c.blend_convs_per_stage);
+    visit("depthwise_separable", c.depthwise_separable);
+    visit("rgb_skip", c.rgb_skip);
+    visit("mask_prior", c.mask_prior);
+    visit("ulr_prior", c.ulr_prior);
+    visit("ulr_num_blend", c.ulr_num_blend);
+    visit("ulr_resolution_weight", c.ulr_resolution_weight);
+  }
 };
 
 }  // namespace fvs
