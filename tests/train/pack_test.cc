@@ -13,9 +13,9 @@
 #include <random>
 #include <set>
 
+#include "fvs/geometry/warp.h"
 #include "fvs/net/net.h"
 #include "fvs/scene/source_selection.h"
-#include "fvs/geometry/warp.h"
 #include "fvs/train/data.h"
 #include "fvs/train/train_options.h"
 #include "fvs/util/atomic_file.h"
@@ -228,7 +228,7 @@ TEST_F(PackTest, CroppedSourcesSampleExactlyWhatTheFullSourcesDo) {
 TEST_F(PackTest, ColourJitterIsTheSameForTargetAndSources) {
   std::vector<PackedScene> scenes = {LoadPackedScene(dir_->path() + "/packed")};
   // The target crop and a source that is the same image must stay identical.
-  TrainingSample s = MakeSample(scenes[0], 1, {1}, 0, 0, 48, 36, WarpSettings());
+  TrainingSample s = MakeSample(scenes[0], 1, {1}, 0, 0, 48, 36, SampleWarpOptions());
   ColorJitter j;
   j.brightness = 0.05;
   j.contrast = 1.1;
@@ -273,7 +273,7 @@ TEST_F(PackTest, TrainingWarpIsTheRenderersWarp) {
       ts.push_back(CameraT(sources[k]));
       ds.push_back(DepthTensor(source_depths[k]));
     }
-    WarpSettings settings;
+    SampleWarpOptions settings;
     settings.ulr_log_weights = true;
     const TrainingWarp warp = ComputeTrainingWarp(
         CameraK(target), CameraR(target), CameraT(target), DepthTensor(target_depth),
@@ -301,7 +301,7 @@ TEST_F(PackTest, TrainingWarpIsTheRenderersWarp) {
           d > 0 ? target.PixelToCamera(i % 40 + 0.5, i / 40 + 0.5, d)
                 : UlrPointAtInfinity(target.PixelToCamera(i % 40 + 0.5, i / 40 + 0.5, 1),
                                      UlrFarDistance(ulr));
-      UlrPointWeights(point, ulr, sees, UlrSettings(), weights);
+      UlrPointWeights(point, ulr, sees, UlrOptions(), weights);
       for (int k = 0; k < 3; ++k) {
         const double expected = std::log(std::max(weights[k], kUlrWeightFloor));
         max_prior_error = std::max(
@@ -344,13 +344,13 @@ TEST_F(PackTest, NoInfDepthLeavesSkyInvalid) {
   PackedScene p = scenes[0];
   p.depths = p.depths.clone();
   p.depths[0].zero_();
-  WarpSettings settings;
-  settings.inf_depth = false;
+  SampleWarpOptions settings;
+  settings.geometry.at_infinity = false;
   const TrainingSample s = MakeSample(p, 0, {1, 2}, 0, 0, 48, 36, settings);
   EXPECT_EQ(s.warp.valid_depth.sum().item<float>(), 0.f);
   EXPECT_EQ(s.warp.valid_warp.sum().item<float>(), 0.f);
   EXPECT_TRUE(torch::isfinite(s.warp.grid).all().item<bool>());
-  settings.inf_depth = true;
+  settings.geometry.at_infinity = true;
   // Points at infinity: their source positions are finite (valid only where the source
   // has sky too, which this closed room has nowhere).
   const TrainingSample t = MakeSample(p, 0, {1, 2}, 0, 0, 48, 36, settings);

@@ -77,7 +77,7 @@ TEST_F(TrainerTest, LossDecreasesOnAFixedSample) {
   torch::set_num_threads(1);
   torch::manual_seed(0);
   const PackedScene scene = LoadPackedScene(dir_->path() + "/scene_a");
-  WarpSettings warp;
+  SampleWarpOptions warp;
   warp.ulr_log_weights = true;  // the prior of fvs_fast
   const TrainingSample s =
       MakeSample(scene, 2, SelectTrainingSources(scene, 2, 2), 16, 8, 32, 32, warp);

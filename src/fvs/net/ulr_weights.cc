@@ -5,9 +5,16 @@
 #include <cmath>
 #include <memory>
 
+#include "fvs/util/error.h"
 #include "fvs/util/parallel.h"
 
 namespace fvs {
+
+void UlrOptions::Check() const {
+  Require(std::isfinite(resolution_weight) && resolution_weight >= 0, "ULR options",
+          "resolution_weight must be finite and >= 0");
+  Require(num_blend >= 1, "ULR options", "num_blend must be at least 1");
+}
 
 namespace {
 
@@ -69,7 +76,7 @@ void UlrWeights(const double* penalties, int n, int k, double* weights) {
 }
 
 int UlrPointWeights(const Eigen::Vector3d& point, const UlrSources& sources,
-                    const bool* sees, const UlrSettings& settings, double* weights) {
+                    const bool* sees, const UlrOptions& settings, double* weights) {
   const int n = sources.size();
   // Small fixed buffers: K is a handful; larger K falls back to the heap.
   double penalty_buffer[32], weight_buffer[32];
@@ -103,7 +110,7 @@ int UlrPointWeights(const Eigen::Vector3d& point, const UlrSources& sources,
 }
 
 void UlrLogWeights(const double* points, int64_t num_pixels, const UlrSources& sources,
-                   const float* sees, const UlrSettings& settings, float* log_weights,
+                   const float* sees, const UlrOptions& settings, float* log_weights,
                    int num_threads) {
   const int n = sources.size();
   const float floor = static_cast<float>(std::log(kUlrWeightFloor));

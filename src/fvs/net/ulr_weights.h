@@ -12,8 +12,8 @@
 // The 1 / p_i factor (as in later ULR implementations) makes a target that coincides with
 // a source reproduce that source exactly.
 //
-// Pixels without a surface (seen at infinity, geometry/warp.h) have no point to measure the
-// angle at: at infinity every source's ray is parallel to the target's and all angles
+// Pixels without a surface (seen at infinity, geometry/warp.h) have no point to measure
+// the angle at: at infinity every source's ray is parallel to the target's and all angles
 // are 0. They are weighed at the point D_far along their ray instead
 // (UlrPointAtInfinity), D_far = kUlrFarFactor (10) times the distance from the target
 // centre to the farthest of its sources' centres (1 when they all coincide with it).
@@ -28,9 +28,12 @@
 
 namespace fvs {
 
-struct UlrSettings {
+struct UlrOptions {
   double resolution_weight = 0.2;  // weight of the resolution penalty vs the angle (rad)
   int num_blend = 4;               // k-nearest: best sources blended per pixel
+  // Throws fvs::Error("ULR options", ...): resolution_weight finite and >= 0, num_blend
+  // >= 1.
+  void Check() const;
 };
 
 // log() of weights below this is clamped to it: finite, and e^-9.2 of the weight.
@@ -68,14 +71,14 @@ Eigen::Vector3d UlrPointAtInfinity(const Eigen::Vector3d& ray, double far_distan
 // sees[s] is false, the others sum to 1. Returns how many sources see the point (0: all
 // weights 0).
 int UlrPointWeights(const Eigen::Vector3d& point, const UlrSources& sources,
-                    const bool* sees, const UlrSettings& settings, double* weights);
+                    const bool* sees, const UlrOptions& settings, double* weights);
 
 // log(max(weight, kUlrWeightFloor)) of every source at every pixel: points are
 // num_pixels x 3 doubles (target camera frame, row-major), sees and log_weights are
 // sources.size() x num_pixels (source-major; sees > 0.5 = the source sees the pixel).
 // A pixel no source sees gets the floor everywhere.
 void UlrLogWeights(const double* points, int64_t num_pixels, const UlrSources& sources,
-                   const float* sees, const UlrSettings& settings, float* log_weights,
+                   const float* sees, const UlrOptions& settings, float* log_weights,
                    int num_threads = 0);
 
 }  // namespace fvs

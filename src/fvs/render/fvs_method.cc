@@ -46,7 +46,7 @@ torch::Tensor UlrLogWeightTensor(const Scene& scene, const TargetView& target,
   const int64_t k = warp_mask.size(0);
   const torch::Tensor sees = warp_mask.reshape({k, num_pixels}).contiguous();
   torch::Tensor log_weights = torch::empty({k, num_pixels}, torch::kFloat32);
-  UlrSettings settings;
+  UlrOptions settings;
   settings.num_blend = config.ulr_num_blend;
   settings.resolution_weight = config.ulr_resolution_weight;
   UlrLogWeights(points.data(), num_pixels, sources, sees.data_ptr<float>(), settings,

@@ -37,7 +37,7 @@ class UlrMethod : public Method {
     }
     const UlrSources ulr_sources = MakeUlrSources(scene, target, prepared);
     const double far_distance = UlrFarDistance(ulr_sources);
-    UlrSettings settings;
+    UlrOptions settings;
     settings.resolution_weight = options_.ulr_resolution_weight;
     settings.num_blend = options_.ulr_num_blend;
     result.color = Image(w, h, 3);

@@ -169,10 +169,11 @@ Image DepthImage(const torch::Tensor& depth) {
 // their depth, the rays of pixels without a surface moved to UlrPointAtInfinity as the
 // renderer's UlrSurfacePoint does. The sources as ULR sees them: centres in the target
 // frame, -R_rel^T t_rel (relative poses as the warp's), focal lengths sqrt(fx fy).
-torch::Tensor TrainingUlrLogWeights(const PinholeCamera& target, const Image& target_depth,
+torch::Tensor TrainingUlrLogWeights(const PinholeCamera& target,
+                                    const Image& target_depth,
                                     const std::vector<PinholeCamera>& sources,
                                     const torch::Tensor& valid_warp,
-                                    const UlrSettings& settings) {
+                                    const UlrOptions& settings) {
   UlrSources ulr;
   ulr.target_focal = std::sqrt(target.fx * target.fy);
   for (const PinholeCamera& source : sources) {
@@ -206,21 +207,35 @@ torch::Tensor TrainingUlrLogWeights(const PinholeCamera& target, const Image& ta
 
 }  // namespace
 
+void SampleWarpOptions::Check() const {
+  geometry.Check();
+  ulr.Check();
+}
+
+SampleWarpOptions SampleWarpOptionsFor(const ModelConfig& config,
+                                       double occlusion_tolerance) {
+  SampleWarpOptions warp;
+  warp.geometry.occlusion_tolerance = occlusion_tolerance;
+  warp.geometry.at_infinity = config.inf_depth;
+  warp.ulr_log_weights = config.ulr_prior > 0;
+  warp.ulr.num_blend = config.ulr_num_blend;
+  warp.ulr.resolution_weight = config.ulr_resolution_weight;
+  return warp;
+}
+
 TrainingWarp ComputeTrainingWarp(
     const torch::Tensor& target_K, const torch::Tensor& target_R,
     const torch::Tensor& target_t, const torch::Tensor& target_depth,
     const torch::Tensor& source_K, const torch::Tensor& source_R,
     const torch::Tensor& source_t, const torch::Tensor& source_depths,
-    const WarpSettings& settings) {
+    const SampleWarpOptions& settings) {
   const int64_t h = target_depth.size(0), w = target_depth.size(1);
   const int64_t k = source_K.size(0), sh = source_depths.size(1),
                 sw = source_depths.size(2);
   const PinholeCamera target = TensorCamera(target_K, target_R, target_t, w, h);
   const Image depth = DepthImage(target_depth);
-  WarpOptions options;
-  options.occlusion_tolerance = settings.occlusion_tolerance;
-  options.invalid_depth = settings.invalid_depth;
-  options.at_infinity = settings.inf_depth;
+  settings.Check();
+  const WarpOptions& options = settings.geometry;
 
   TrainingWarp out;
   out.grid = torch::empty({k, h, w, 2}, torch::kFloat);
@@ -231,8 +246,8 @@ TrainingWarp ComputeTrainingWarp(
   for (int64_t s = 0; s < k; ++s) {
     sources.push_back(TensorCamera(source_K[s], source_R[s], source_t[s], sw, sh));
     // The warp in double from the relative poses (geometry/warp.h), the renderer's.
-    const WarpMap map =
-        ComputeWarpMap(target, depth, sources.back(), DepthImage(source_depths[s]), options);
+    const WarpMap map = ComputeWarpMap(target, depth, sources.back(),
+                                       DepthImage(source_depths[s]), options);
     const Image grid =
         GridSampleCoordinates(map, static_cast<int>(sw), static_cast<int>(sh));
     std::memcpy(out.grid[s].data_ptr<float>(), grid.data.data(), 2 * n * sizeof(float));
@@ -258,7 +273,7 @@ TrainingWarp ComputeTrainingWarp(
 
 TrainingSample MakeSample(const PackedScene& scene, int target,
                           const std::vector<int>& sources, int x0, int y0, int crop_width,
-                          int crop_height, const WarpSettings& settings) {
+                          int crop_height, const SampleWarpOptions& settings) {
   using torch::indexing::Slice;
   Require(!sources.empty(), scene.path,
           "target " + scene.names.at(target) + " has no source");
@@ -360,7 +375,8 @@ TrainingSampler::TrainingSampler(const std::vector<PackedScene>* scenes,
     : scenes_(scenes), options_(options), rng_(seed) {
   for (size_t s = 0; s < scenes->size(); ++s) {
     for (int v = 0; v < (*scenes)[s].num_views(); ++v) {
-      if (!(*scenes)[s].holdout[v] && !SelectTrainingSources((*scenes)[s], v, 1).empty()) {
+      if (!(*scenes)[s].holdout[v] &&
+          !SelectTrainingSources((*scenes)[s], v, 1).empty()) {
         targets_.emplace_back(static_cast<int>(s), v);
       }
     }

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "fvs/geometry/warp.h"
+#include "fvs/net/model_config.h"
 #include "fvs/net/ulr_weights.h"
 
 namespace fvs {
@@ -44,23 +46,27 @@ std::vector<int> SelectTrainingSources(const PackedScene& scene, int target, int
 // out (fewer when the scene has fewer).
 std::vector<int> ValidationTargets(const PackedScene& scene, int count);
 
-struct WarpSettings {
-  double occlusion_tolerance = 0.01;  // |z - D_source| <= tol * z
-  // No-surface target pixels warped at infinity (rotation only; geometry/warp.h); false:
-  // they are invalid.
-  bool inf_depth = true;
-  double invalid_depth = 1e9;  // what a source pixel without a surface counts as
-  // Also compute the ULR log-weights (the prior of ModelConfig::ulr_prior) with these
-  // settings.
+// How a training sample is warped: the renderer's warp (geometry/warp.h) and, for the
+// prior and the baseline, the ULR log-weights.
+struct SampleWarpOptions {
+  WarpOptions geometry;  // occlusion test, what is at infinity
+  // Also compute the ULR log-weights (the prior of ModelConfig::ulr_prior) with `ulr`.
   bool ulr_log_weights = false;
-  UlrSettings ulr;
+  UlrOptions ulr;
+  void Check() const;  // throws fvs::Error
 };
+
+// The warp a network of `config` trains and validates with: at infinity when
+// config.inf_depth, ULR log-weights with the config's ULR settings when it has a ULR
+// prior (the trainer, the headroom and the render benchmark all warp this way).
+SampleWarpOptions SampleWarpOptionsFor(const ModelConfig& config,
+                                       double occlusion_tolerance);
 
 struct TrainingWarp {
   torch::Tensor grid;         // float [K,h,w,2], grid_sample (align_corners = false)
   torch::Tensor valid_depth;  // float [1,1,h,w]
   torch::Tensor valid_warp;   // float [K,1,h,w]
-  // float [K,1,h,w], UlrLogWeights (only with WarpSettings::ulr_log_weights).
+  // float [K,1,h,w], UlrLogWeights (only with SampleWarpOptions::ulr_log_weights).
   torch::Tensor ulr_log_weights;
 };
 
@@ -78,7 +84,7 @@ TrainingWarp ComputeTrainingWarp(
     const torch::Tensor& target_t, const torch::Tensor& target_depth,
     const torch::Tensor& source_K, const torch::Tensor& source_R,
     const torch::Tensor& source_t, const torch::Tensor& source_depths,
-    const WarpSettings& settings);
+    const SampleWarpOptions& settings);
 
 struct TrainingSample {
   int scene = 0, target = 0, x0 = 0, y0 = 0;
@@ -92,7 +98,7 @@ struct TrainingSample {
 // by the crop origin), with the given sources at full size.
 TrainingSample MakeSample(const PackedScene& scene, int target,
                           const std::vector<int>& sources, int x0, int y0, int crop_width,
-                          int crop_height, const WarpSettings& settings);
+                          int crop_height, const SampleWarpOptions& settings);
 
 // FillHoles (util/hole_filling.h) on a [1,3,H,W] image in [0,1], as the renderer fills
 // pixels no source sees; covered and surface are [1,1,H,W] (> 0 = yes).
@@ -124,7 +130,7 @@ struct SamplerOptions {
   // >= 0: CropSourcesToFootprint with this margin (the trainer's default, 16); < 0: full
   // sources.
   int source_margin = -1;
-  WarpSettings warp;
+  SampleWarpOptions warp;
 };
 
 // Random leave-one-out samples: a target uniformly over all views of all scenes that have

@@ -53,13 +53,13 @@ torch::Tensor GlobalOracle(const torch::Tensor& colours, const torch::Tensor& se
 
 std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
                                          int num_sources, int views_per_scene,
-                                         const WarpSettings& warp_settings,
+                                         const SampleWarpOptions& warp_settings,
                                          const ImageDistance& lpips) {
   const char* kMethods[] = {"ulr", "oracle_pixel", "oracle_global"};
   std::vector<HeadroomRow> rows, all(3);
   const double no_lpips = lpips ? 0.0 : -1.0;
   for (int m = 0; m < 3; ++m) all[m] = {"all", kMethods[m], 0, 0, 0, no_lpips};
-  WarpSettings settings = warp_settings;
+  SampleWarpOptions settings = warp_settings;
   settings.ulr_log_weights = true;
   for (const PackedScene& scene : scenes) {
     std::vector<HeadroomRow> mine(3);

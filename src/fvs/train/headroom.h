@@ -35,7 +35,7 @@ using ImageDistance = std::function<double(const torch::Tensor&, const torch::Te
 // means over all views (scene "all").
 std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
                                          int num_sources, int views_per_scene,
-                                         const WarpSettings& warp,
+                                         const SampleWarpOptions& warp,
                                          const ImageDistance& lpips);
 
 // Writes the rows as CSV (scene,method,views,psnr,ssim,lpips), atomically.

@@ -26,7 +26,7 @@ ViewScores ScoreView(const torch::Tensor& image, const torch::Tensor& target,
 
 PackedViewRender RenderPackedView(FvsNet& net, const PackedScene& scene, int target,
                                   const std::vector<int>& sources,
-                                  const WarpSettings& warp, const torch::Device& device,
+                                  const SampleWarpOptions& warp, const torch::Device& device,
                                   torch::ScalarType dtype, bool with_ulr) {
   auto sync = [&] {
     if (device.is_cuda()) torch::cuda::synchronize();

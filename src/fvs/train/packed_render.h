@@ -44,7 +44,7 @@ struct PackedViewRender {
 // InferenceMode with the network in eval().
 PackedViewRender RenderPackedView(FvsNet& net, const PackedScene& scene, int target,
                                   const std::vector<int>& sources,
-                                  const WarpSettings& warp, const torch::Device& device,
+                                  const SampleWarpOptions& warp, const torch::Device& device,
                                   torch::ScalarType dtype, bool with_ulr);
 
 // The scene at another size: photos resized bilinearly, depths by nearest neighbour (no

@@ -35,9 +35,10 @@ void WriteCsv(const std::string& path, const std::vector<Row>& rows) {
            "psnr,ulr_psnr\n";
     char line[256];
     for (const Row& r : rows) {
-      std::snprintf(line, sizeof(line), "%d,%d,%d,%s,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f\n",
-                    r.width, r.height, r.k, r.precision.c_str(), r.views, r.warp_s,
-                    r.cpu_warp_s, r.network_s, r.rest_s, r.total(), r.psnr, r.ulr_psnr);
+      std::snprintf(line, sizeof(line),
+                    "%d,%d,%d,%s,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f\n", r.width,
+                    r.height, r.k, r.precision.c_str(), r.views, r.warp_s, r.cpu_warp_s,
+                    r.network_s, r.rest_s, r.total(), r.psnr, r.ulr_psnr);
       out << line;
     }
   });
@@ -83,26 +84,24 @@ TrainSummary RunRenderBenchmark(const TrainOptions& options) {
   for (const std::string& folder : ReadSceneList(options.val_scene_list)) {
     scenes.push_back(LoadPackedScene(folder));
   }
-  WarpSettings warp;
-  warp.occlusion_tolerance = options.occlusion_tolerance;
-  warp.inf_depth = config.inf_depth;
+  SampleWarpOptions warp = SampleWarpOptionsFor(config, options.occlusion_tolerance);
   warp.ulr_log_weights = true;  // the baseline's weights, and the prior's
-  warp.ulr.num_blend = config.ulr_num_blend;
-  warp.ulr.resolution_weight = config.ulr_resolution_weight;
 
-  std::printf("render benchmark: %s (%s weights), %s, LibTorch %d.%d.%d, %d threads, "
-              "%u cores, %s\n",
-              config.variant.c_str(),
-              options.init_weights.empty() ? "fresh, untrained"
-                                           : options.init_weights.c_str(),
-              device.is_cuda() ? "CUDA" : "CPU", TORCH_VERSION_MAJOR, TORCH_VERSION_MINOR,
-              TORCH_VERSION_PATCH, torch::get_num_threads(),
-              std::thread::hardware_concurrency(), CpuModelName().c_str());
-  std::printf("scenes: %zu validation scene(s), %d view(s) each per cell, resized from "
-              "the packs; time bound %.0f s\n",
-              scenes.size(), options.bench_views, options.bench_seconds);
+  std::printf(
+      "render benchmark: %s (%s weights), %s, LibTorch %d.%d.%d, %d threads, "
+      "%u cores, %s\n",
+      config.variant.c_str(),
+      options.init_weights.empty() ? "fresh, untrained" : options.init_weights.c_str(),
+      device.is_cuda() ? "CUDA" : "CPU", TORCH_VERSION_MAJOR, TORCH_VERSION_MINOR,
+      TORCH_VERSION_PATCH, torch::get_num_threads(), std::thread::hardware_concurrency(),
+      CpuModelName().c_str());
+  std::printf(
+      "scenes: %zu validation scene(s), %d view(s) each per cell, resized from "
+      "the packs; time bound %.0f s\n",
+      scenes.size(), options.bench_views, options.bench_seconds);
   std::printf("%9s %2s %5s %5s %9s %9s %9s %9s %9s %8s %8s\n", "size", "K", "prec",
-              "views", "warp_s", "(cpu)", "network_s", "rest_s", "total_s", "psnr", "ulr");
+              "views", "warp_s", "(cpu)", "network_s", "rest_s", "total_s", "psnr",
+              "ulr");
   std::fflush(stdout);
 
   std::filesystem::create_directories(options.output_path);
@@ -133,7 +132,8 @@ TrainSummary RunRenderBenchmark(const TrainOptions& options) {
                          static_cast<double>(grid.sizes.size() - si);
     Timer size_clock;
     std::vector<PackedScene> resized;
-    for (const PackedScene& s : scenes) resized.push_back(ResizePackedScene(s, width, height));
+    for (const PackedScene& s : scenes)
+      resized.push_back(ResizePackedScene(s, width, height));
     std::map<std::string, bool> warmed;  // one untimed view per size and precision
     for (const int k : grid.ks) {
       double ulr_psnr = -1;
@@ -176,13 +176,14 @@ TrainSummary RunRenderBenchmark(const TrainOptions& options) {
             row.network_s += v.network_s;
             row.rest_s += v.rest_s;
             row.psnr += ScoreView(v.prediction, v.target, LpipsNet{nullptr}).psnr;
-            if (ulr_psnr < 0) ulr_sum += ScoreView(v.ulr, v.target, LpipsNet{nullptr}).psnr;
+            if (ulr_psnr < 0)
+              ulr_sum += ScoreView(v.ulr, v.target, LpipsNet{nullptr}).psnr;
             ++row.views;
           }
         }
         if (row.views == 0) continue;
-        for (double* x : {&row.warp_s, &row.cpu_warp_s, &row.network_s, &row.rest_s,
-                          &row.psnr}) {
+        for (double* x :
+             {&row.warp_s, &row.cpu_warp_s, &row.network_s, &row.rest_s, &row.psnr}) {
           *x /= row.views;
         }
         if (ulr_psnr < 0) ulr_psnr = ulr_sum / row.views;
@@ -198,7 +199,8 @@ TrainSummary RunRenderBenchmark(const TrainOptions& options) {
     }
   }
   for (const std::string& s : skipped) std::printf("skipped: %s\n", s.c_str());
-  std::printf("wrote %s (%zu rows) in %.1f s\n", csv.c_str(), rows.size(), clock.Seconds());
+  std::printf("wrote %s (%zu rows) in %.1f s\n", csv.c_str(), rows.size(),
+              clock.Seconds());
   TrainSummary summary;
   summary.seconds = clock.Seconds();
   return summary;

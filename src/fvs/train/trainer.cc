@@ -81,12 +81,6 @@ std::string UtcNow() {
   return buf;
 }
 
-void SetUlrPrior(const ModelConfig& config, WarpSettings* warp) {
-  warp->ulr_log_weights = config.ulr_prior > 0;
-  warp->ulr.num_blend = config.ulr_num_blend;
-  warp->ulr.resolution_weight = config.ulr_resolution_weight;
-}
-
 // The quality sums of a scene or of all scenes (ValidationResult and its Scene share
 // the field names).
 template <typename Sums>
@@ -247,9 +241,7 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
   sampler.crop = options_.crop;
   sampler.augment = options_.augment;
   sampler.source_margin = options_.source_margin;
-  sampler.warp.occlusion_tolerance = options_.occlusion_tolerance;
-  sampler.warp.inf_depth = config_.inf_depth;
-  SetUlrPrior(config_, &sampler.warp);
+  sampler.warp = SampleWarpOptionsFor(config_, options_.occlusion_tolerance);
   // A seed of its own stream: the sampler must not share draws with LibTorch.
   sampler_ = std::make_unique<TrainingSampler>(
       &train_scenes_, sampler,
@@ -325,10 +317,7 @@ ValidationResult Trainer::Validate() {
   result.has_lpips = !lpips_.is_empty();
   torch::NoGradGuard no_grad;
   net_->eval();
-  WarpSettings warp;
-  warp.occlusion_tolerance = options_.occlusion_tolerance;
-  warp.inf_depth = config_.inf_depth;
-  SetUlrPrior(config_, &warp);
+  SampleWarpOptions warp = SampleWarpOptionsFor(config_, options_.occlusion_tolerance);
   warp.ulr_log_weights = true;  // for the baseline, whatever the network
   int total_views = 0;
   for (const PackedScene& scene : val_scenes_) {
@@ -540,10 +529,8 @@ TrainSummary RunHeadroom(const TrainOptions& options) {
   ConfigureTorchThreads();
   if (options.num_threads > 0) torch::set_num_threads(options.num_threads);
   const ModelConfig config = ModelConfig::ForVariant(options.variant);
-  WarpSettings warp;
-  warp.occlusion_tolerance = options.occlusion_tolerance;
-  warp.inf_depth = config.inf_depth;
-  SetUlrPrior(config, &warp);
+  const SampleWarpOptions warp =
+      SampleWarpOptionsFor(config, options.occlusion_tolerance);
   ImageDistance distance;
   const std::string lpips_path = ResolveLpipsPath(options.lpips_path);
   if (!lpips_path.empty()) {
