@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "fvs/mvs/isolated_points.h"
+#include "fvs/util/check.h"
 #include "fvs/util/error.h"
 #include "fvs/util/parallel.h"
 #include "fvs/util/progress.h"
@@ -768,8 +769,7 @@ TriangleMesh DelaunayMeshing(const DelaunayMeshingInput& input,
   stats->num_isolated_points = num_isolated;
   stats->num_sparse_points = input.num_sparse_points;
   for (const auto& v : mesh.vertices) {
-    Require(v.allFinite(), input.points_subject,
-            "non-finite mesh vertex (internal error)");
+    FVS_CHECK(v.allFinite(), "non-finite mesh vertex from " + input.points_subject);
   }
   return mesh;
 }

@@ -14,6 +14,7 @@
 #include "fvs/geometry/ply.h"
 #include "fvs/mvs/delaunay.h"
 #include "fvs/mvs/isolated_points.h"
+#include "fvs/util/check.h"
 #include "fvs/util/error.h"
 #include "fvs/util/progress.h"
 #include "fvs/util/string_util.h"
@@ -156,8 +157,7 @@ void DelaunayMeshingInput::Check() const {
   Require(points.size() >= 4, points_subject,
           "only " + std::to_string(points.size()) +
               " points: a volume needs at least 4 (degenerate point cloud)");
-  Require(num_sparse_points <= points.size(), kWho,
-          "more SfM points than points (internal error)");
+  FVS_CHECK(num_sparse_points <= points.size(), "more SfM points than points");
   Require(visibility.size() == points.size(), visibility_subject,
           "has " + std::to_string(visibility.size()) +
               " points but the point cloud has " + std::to_string(points.size()) +
