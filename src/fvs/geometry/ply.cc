@@ -258,8 +258,12 @@ void ReadFaceElement(const std::string& path, const PlyElement& element,
         throw Error(path, "face " + std::to_string(i) + ": bad list length " +
                               std::to_string(count));
       }
-      if (count * TypeSize(p.type) > static_cast<double>(reader.remaining()) &&
-          reader.encoding() != Encoding::kAscii) {
+      // Bound the length by the bytes left before allocating for it: an ASCII value
+      // takes at least one character (a length of 1e15 in a text file once asked for
+      // 8 PB, reproduced by tests/fuzz/ply_fuzzer).
+      const double min_bytes =
+          reader.encoding() == Encoding::kAscii ? 1.0 : TypeSize(p.type);
+      if (count * min_bytes > static_cast<double>(reader.remaining())) {
         reader.Truncated("face", i);
       }
       const int64_t n = static_cast<int64_t>(count);
