@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "fvs/util/error.h"
@@ -76,6 +77,15 @@ TEST(TargetsTest, BadImagesTxtAreErrors) {
   expect_error("1 1 0 0 0 0 0 0 2 x.png\n\n", "image size must be positive");
   WriteTextFile(dir / "cameras.txt", "2 OPENCV 40 30 32 32 20 15 0 0 0 0\n");
   expect_error("1 1 0 0 0 0 0 0 2 x.png\n\n", "has distortion");
+  // Camera ids are whole numbers that fit uint32 (1e20 was cast to uint32_t: undefined
+  // behaviour, reproduced by tests/fuzz/target_images_fuzzer).
+  for (const char* id : {"1e20", "-1", "2.5", "4294967296"}) {
+    std::filesystem::remove(dir / "cameras.txt");  // read first, when there
+    expect_error(std::string("1 1 0 0 0 0 0 0 ") + id + " x.png\n\n",
+                 "expected IMAGE_ID");
+    WriteTextFile(dir / "cameras.txt", std::string(id) + " PINHOLE 40 30 32 32 20 15\n");
+    expect_error("1 1 0 0 0 0 0 0 2 x.png\n\n", "malformed camera line");
+  }
 }
 
 TEST(TargetsTest, NerfstudioCameraPathRoundTrip) {
