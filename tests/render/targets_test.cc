@@ -122,6 +122,19 @@ TEST(TargetsTest, NerfstudioCameraPathRoundTrip) {
   WriteTextFile(dir / "bad.json",
                 "{\"render_width\": 0, \"render_height\": 4, \"camera_path\": []}");
   EXPECT_THROW(ReadNerfstudioCameraPath(dir / "bad.json"), Error);
+  // Sizes that do not fit an int: 1e30 was cast to int (undefined behaviour) and
+  // 4294967360 wrapped to 64 (reproduced by tests/fuzz/camera_path_fuzzer).
+  for (const char* size : {"1e30", "4294967360", "64.5", "\"64\""}) {
+    json["render_width"] = nlohmann::json::parse(size);
+    WriteTextFile(dir / "bad.json", json.dump());
+    try {
+      ReadNerfstudioCameraPath(dir / "bad.json");
+      FAIL() << "no error for render_width " << size;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("render_width"), std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 TEST(TargetsTest, OrbitLooksAtTheCentreAndInterpolationHitsTheViews) {

@@ -15,6 +15,7 @@
 #include "fvs/scene/scene.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
+#include "fvs/util/json_number.h"
 #include "fvs/util/string_util.h"
 
 namespace fvs {
@@ -213,10 +214,10 @@ std::vector<TargetCamera> ReadNerfstudioCameraPath(const std::string& path) {
   }
   std::vector<TargetCamera> targets;
   try {
-    const int width = json.at("render_width").get<int>();
-    const int height = json.at("render_height").get<int>();
-    Require(width > 0 && height > 0 && width < 100000 && height < 100000, path,
-            "render_width and render_height must be positive");
+    int width = 0, height = 0;
+    Require(JsonToInt(json.at("render_width"), 1, 99999, &width) &&
+                JsonToInt(json.at("render_height"), 1, 99999, &height),
+            path, "render_width and render_height must be positive whole numbers");
     const auto& frames = json.at("camera_path");
     Require(frames.is_array() && !frames.empty(), path, "camera_path is empty");
     for (size_t i = 0; i < frames.size(); ++i) {
