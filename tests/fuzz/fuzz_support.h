@@ -7,6 +7,7 @@
 #pragma once
 
 #include <stdlib.h>
+#include <unistd.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -28,8 +29,15 @@ inline const std::string kSeparator = "\n=FVS-NEXT-FILE=\n";
 // of objects constructed later, so it must not read a destroyed string.
 inline const std::string& ScratchDir() {
   static const std::string* const dir = [] {
-    std::string pattern =
-        (std::filesystem::temp_directory_path() / "fvs_fuzz_XXXXXX").string();
+    // Memory-backed when possible: on a disk the write and read of each input cost
+    // five times the parsing (250 instead of 1300 executions per second measured).
+    std::error_code ec;
+    const std::filesystem::path base =
+        getenv("TMPDIR") == nullptr && std::filesystem::is_directory("/dev/shm", ec) &&
+                access("/dev/shm", W_OK) == 0
+            ? std::filesystem::path("/dev/shm")
+            : std::filesystem::temp_directory_path();
+    std::string pattern = (base / "fvs_fuzz_XXXXXX").string();
     if (mkdtemp(pattern.data()) == nullptr) {
       std::perror("mkdtemp");
       std::abort();
