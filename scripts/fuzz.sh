@@ -46,10 +46,14 @@ for name in "${targets[@]}"; do
   mkdir -p "$corpus" "$findings" "$(dirname "$log")"
   # -timeout: an input taking over 10 s is a hang; -rss_limit_mb: over 2.5 GB is an
   # out-of-memory finding (OSS-Fuzz's limits).
+  # Keywords and edge numbers of the text formats (tests/fuzz/dicts/): random bytes
+  # rarely spell "render_width" or 1e30.
+  dict=()
+  if [[ -f "tests/fuzz/dicts/$name.dict" ]]; then dict=(-dict="tests/fuzz/dicts/$name.dict"); fi
   start=$(date +%s)
   set +e
   "$BUILD_DIR/bin/fuzz/${name}_fuzzer" -max_total_time="$SECONDS_PER_TARGET" \
-    -timeout=10 -rss_limit_mb=2560 -print_final_stats=1 \
+    -timeout=10 -rss_limit_mb=2560 -print_final_stats=1 "${dict[@]}" \
     -artifact_prefix="$findings/" "$corpus" "$BUILD_DIR/seeds/$name" >"$log" 2>&1
   rc=$?
   set -e
