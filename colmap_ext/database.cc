@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 
 #include "colmap_ext/camera_models.h"
@@ -53,6 +54,21 @@ int64_t NonNegative(sqlite3_stmt* stmt, int column, const std::string& path,
   return v;
 }
 
+// An id (COLMAP's are uint32) or a count that must fit `max`: a larger value would wrap
+// in the cast and alias another camera or image silently.
+int64_t InRange(sqlite3_stmt* stmt, int column, const std::string& path, const char* what,
+                int64_t max) {
+  const int64_t v = NonNegative(stmt, column, path, what);
+  if (v > max) {
+    throw Error(path, std::string(what) + " " + std::to_string(v) +
+                          " in the database is out of range (at most " +
+                          std::to_string(max) + ")");
+  }
+  return v;
+}
+
+constexpr int64_t kMaxId = std::numeric_limits<uint32_t>::max();
+
 // Seven columns from `first`: qw, qx, qy, qz, tx, ty, tz; NULL or NaN when unknown.
 void ReadPosePrior(sqlite3_stmt* s, int first, DatabaseImage* image) {
   double prior[7];
@@ -85,27 +101,28 @@ DatabaseContents ReadDatabase(const std::string& path) {
                           (raw ? sqlite3_errmsg(raw) : "out of memory") + ")");
   }
   DatabaseContents contents;
-  ForEachRow(
-      db.get(), path, "SELECT camera_id, model, width, height, params FROM cameras",
-      [&](sqlite3_stmt* s) {
-        Camera camera;
-        camera.camera_id = static_cast<uint32_t>(NonNegative(s, 0, path, "camera id"));
-        camera.model_id = sqlite3_column_int(s, 1);
-        camera.width = NonNegative(s, 2, path, "camera width");
-        camera.height = NonNegative(s, 3, path, "camera height");
-        // COLMAP stores the parameters as a blob of little-endian doubles.
-        const int bytes = sqlite3_column_bytes(s, 4);
-        const void* blob = sqlite3_column_blob(s, 4);
-        if (bytes % sizeof(double) != 0) {
-          throw Error(path, "camera " + std::to_string(camera.camera_id) +
-                                ": parameter blob of " + std::to_string(bytes) +
-                                " bytes is not a list of doubles");
-        }
-        camera.params.resize(bytes / sizeof(double));
-        if (bytes > 0) std::memcpy(camera.params.data(), blob, bytes);
-        internal::CheckCamera(camera, path);
-        contents.cameras[camera.camera_id] = camera;
-      });
+  ForEachRow(db.get(), path,
+             "SELECT camera_id, model, width, height, params FROM cameras",
+             [&](sqlite3_stmt* s) {
+               Camera camera;
+               camera.camera_id =
+                   static_cast<uint32_t>(InRange(s, 0, path, "camera id", kMaxId));
+               camera.model_id = sqlite3_column_int(s, 1);
+               camera.width = NonNegative(s, 2, path, "camera width");
+               camera.height = NonNegative(s, 3, path, "camera height");
+               // COLMAP stores the parameters as a blob of little-endian doubles.
+               const int bytes = sqlite3_column_bytes(s, 4);
+               const void* blob = sqlite3_column_blob(s, 4);
+               if (bytes % sizeof(double) != 0) {
+                 throw Error(path, "camera " + std::to_string(camera.camera_id) +
+                                       ": parameter blob of " + std::to_string(bytes) +
+                                       " bytes is not a list of doubles");
+               }
+               camera.params.resize(bytes / sizeof(double));
+               if (bytes > 0) std::memcpy(camera.params.data(), blob, bytes);
+               internal::CheckCamera(camera, path);
+               contents.cameras[camera.camera_id] = camera;
+             });
   // COLMAP 3.8 keeps pose priors in the images table; later versions moved them out.
   bool has_prior_columns = false;
   ForEachRow(db.get(), path, "PRAGMA table_info(images)", [&](sqlite3_stmt* s) {
@@ -121,10 +138,10 @@ DatabaseContents ReadDatabase(const std::string& path) {
           : "SELECT image_id, name, camera_id FROM images";
   ForEachRow(db.get(), path, image_query, [&](sqlite3_stmt* s) {
     DatabaseImage image;
-    image.image_id = static_cast<uint32_t>(NonNegative(s, 0, path, "image id"));
+    image.image_id = static_cast<uint32_t>(InRange(s, 0, path, "image id", kMaxId));
     const unsigned char* name = sqlite3_column_text(s, 1);
     image.name = name ? reinterpret_cast<const char*>(name) : "";
-    image.camera_id = static_cast<uint32_t>(NonNegative(s, 2, path, "camera id"));
+    image.camera_id = static_cast<uint32_t>(InRange(s, 2, path, "camera id", kMaxId));
     if (contents.cameras.count(image.camera_id) == 0) {
       throw Error(path, "image " + image.name + " refers to missing camera " +
                             std::to_string(image.camera_id));
@@ -134,11 +151,11 @@ DatabaseContents ReadDatabase(const std::string& path) {
   });
   ForEachRow(
       db.get(), path, "SELECT image_id, rows FROM keypoints", [&](sqlite3_stmt* s) {
-        const auto it =
-            contents.images.find(static_cast<uint32_t>(sqlite3_column_int64(s, 0)));
+        const auto it = contents.images.find(
+            static_cast<uint32_t>(InRange(s, 0, path, "image id", kMaxId)));
         if (it != contents.images.end()) {
-          it->second.num_keypoints =
-              static_cast<int>(NonNegative(s, 1, path, "keypoint count"));
+          it->second.num_keypoints = static_cast<int>(
+              InRange(s, 1, path, "keypoint count", std::numeric_limits<int>::max()));
         }
       });
   ForEachRow(

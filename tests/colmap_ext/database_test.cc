@@ -120,5 +120,53 @@ TEST(Database, BadFilesAreNamed) {
   expect_error(dir / "empty.db", "no such table");
 }
 
+// Ids past uint32 (and keypoint counts past int) are errors, not wrapped onto other
+// cameras and images (found reviewing ReadDatabase for tests/fuzz/database_fuzzer).
+TEST(Database, OutOfRangeIdsAreErrors) {
+  TempDir dir;
+  const char* const kSchema =
+      "CREATE TABLE cameras (camera_id INTEGER PRIMARY KEY, model INTEGER, width "
+      "INTEGER, "
+      "height INTEGER, params BLOB, prior_focal_length INTEGER);"
+      "CREATE TABLE images (image_id INTEGER PRIMARY KEY, name TEXT, camera_id INTEGER);"
+      "CREATE TABLE keypoints (image_id INTEGER PRIMARY KEY, rows INTEGER, cols INTEGER, "
+      "data BLOB);"
+      "CREATE TABLE matches (pair_id INTEGER PRIMARY KEY, rows INTEGER);"
+      "CREATE TABLE two_view_geometries (pair_id INTEGER PRIMARY KEY, rows INTEGER);"
+      // SIMPLE_PINHOLE f=8, cx=4, cy=3.
+      "INSERT INTO cameras VALUES (1, 0, 8, 6, "
+      "X'000000000000204000000000000010400000000000000840', 0);";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"INSERT INTO cameras VALUES (4294967297, 0, 8, 6, "
+       "X'000000000000204000000000000010400000000000000840', 0);",
+       "camera id 4294967297"},
+      {"INSERT INTO images VALUES (4294967297, 'a.png', 1);", "image id 4294967297"},
+      {"INSERT INTO images VALUES (1, 'a.png', 4294967297);", "camera id 4294967297"},
+      {"INSERT INTO images VALUES (1, 'a.png', 1);"
+       "INSERT INTO keypoints VALUES (1, 4294967296, 128, NULL);",
+       "keypoint count 4294967296"},
+      {"INSERT INTO keypoints VALUES (4294967297, 5, 128, NULL);",
+       "image id 4294967297"}};
+  int n = 0;
+  for (const auto& [rows, fault] : cases) {
+    const std::string db = dir / ("ids" + std::to_string(n++) + ".db");
+    sqlite3* handle = nullptr;
+    ASSERT_EQ(sqlite3_open(db.c_str(), &handle), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(handle, (std::string(kSchema) + rows).c_str(), nullptr,
+                           nullptr, nullptr),
+              SQLITE_OK)
+        << rows;
+    sqlite3_close(handle);
+    try {
+      ReadDatabase(db);
+      ADD_FAILURE() << "no error for " << rows;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(fault), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("out of range"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace fvs::colmap

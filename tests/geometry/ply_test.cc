@@ -345,6 +345,22 @@ TEST(PlyTest, HugeCountsAreRefusedBeforeAllocating) {
   AppendRaw<int32_t>(&s, 0);
   WriteBytes(path, s);
   EXPECT_NE(ErrorOf([&] { ReadPlyMesh(path); }).find("truncated"), std::string::npos);
+  // The same in ASCII, where the length is a number of any size (tests/fuzz/ply_fuzzer).
+  WriteBytes(
+      path,
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+      "end_header\n0 0 0\n1 0 0\n0 1 0\n1e15 0 1 2\n");
+  EXPECT_NE(ErrorOf([&] { ReadPlyMesh(path); }).find("truncated"), std::string::npos);
+  // A point cloud skips the faces, and skipped a length of 1e150 through an int64_t cast
+  // (undefined behaviour, found by tests/fuzz/ply_fuzzer).
+  WriteBytes(
+      path,
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+      "end_header\n0 0 0\n1 0 0\n0 1 0\n1e150 0 1 2\n");
+  EXPECT_NE(ErrorOf([&] { ReadPlyPointCloud(path); }).find("truncated"),
+            std::string::npos);
 }
 
 TEST(PlyTest, WriterRefusesWhatItCannotWrite) {

@@ -225,6 +225,36 @@ TEST(CameraPathTest, CameraPathJsonRoundTrip) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("bad.json"), std::string::npos) << e.what();
   }
+  // Sizes that do not fit an int, and an aspect with no int width: each was cast to int
+  // (undefined behaviour, reproduced by tests/fuzz/camera_path_fuzzer).
+  for (const auto& [key, value] :
+       std::vector<std::pair<std::string, std::string>>{{"render_width", "1e30"},
+                                                        {"render_height", "-1e30"},
+                                                        {"render_width", "4294967376"},
+                                                        {"width", "1e30"},
+                                                        {"height", "3.5"}}) {
+    nlohmann::json bad = legacy;
+    nlohmann::json& where = key == "width" || key == "height" ? bad["keyframes"][0] : bad;
+    where[key] = nlohmann::json::parse(value);
+    testing::WriteTextFile(dir / "bad.json", bad.dump());
+    try {
+      ReadNerfstudioKeyframes(dir / "bad.json");
+      FAIL() << "no error for " << key << " " << value;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+  nlohmann::json wide = legacy;
+  wide.erase("render_width");
+  wide["keyframes"][0]["aspect"] = 1e300;
+  testing::WriteTextFile(dir / "bad.json", wide.dump());
+  try {
+    ReadNerfstudioKeyframes(dir / "bad.json");
+    FAIL() << "no error for aspect 1e300";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no usable size"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(CameraPathTest, ImagesTxtRoundTripThroughColmap) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "fvs/util/error.h"
@@ -76,6 +77,15 @@ TEST(TargetsTest, BadImagesTxtAreErrors) {
   expect_error("1 1 0 0 0 0 0 0 2 x.png\n\n", "image size must be positive");
   WriteTextFile(dir / "cameras.txt", "2 OPENCV 40 30 32 32 20 15 0 0 0 0\n");
   expect_error("1 1 0 0 0 0 0 0 2 x.png\n\n", "has distortion");
+  // Camera ids are whole numbers that fit uint32 (1e20 was cast to uint32_t: undefined
+  // behaviour, reproduced by tests/fuzz/target_images_fuzzer).
+  for (const char* id : {"1e20", "-1", "2.5", "4294967296"}) {
+    std::filesystem::remove(dir / "cameras.txt");  // read first, when there
+    expect_error(std::string("1 1 0 0 0 0 0 0 ") + id + " x.png\n\n",
+                 "expected IMAGE_ID");
+    WriteTextFile(dir / "cameras.txt", std::string(id) + " PINHOLE 40 30 32 32 20 15\n");
+    expect_error("1 1 0 0 0 0 0 0 2 x.png\n\n", "malformed camera line");
+  }
 }
 
 TEST(TargetsTest, NerfstudioCameraPathRoundTrip) {
@@ -112,6 +122,19 @@ TEST(TargetsTest, NerfstudioCameraPathRoundTrip) {
   WriteTextFile(dir / "bad.json",
                 "{\"render_width\": 0, \"render_height\": 4, \"camera_path\": []}");
   EXPECT_THROW(ReadNerfstudioCameraPath(dir / "bad.json"), Error);
+  // Sizes that do not fit an int: 1e30 was cast to int (undefined behaviour) and
+  // 4294967360 wrapped to 64 (reproduced by tests/fuzz/camera_path_fuzzer).
+  for (const char* size : {"1e30", "4294967360", "64.5", "\"64\""}) {
+    json["render_width"] = nlohmann::json::parse(size);
+    WriteTextFile(dir / "bad.json", json.dump());
+    try {
+      ReadNerfstudioCameraPath(dir / "bad.json");
+      FAIL() << "no error for render_width " << size;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("render_width"), std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 TEST(TargetsTest, OrbitLooksAtTheCentreAndInterpolationHitsTheViews) {

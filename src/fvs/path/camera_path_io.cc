@@ -11,6 +11,7 @@
 #include "fvs/scene/scene.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
+#include "fvs/util/json_number.h"
 
 namespace fvs {
 
@@ -123,8 +124,17 @@ std::vector<CameraPathKeyframe> ReadNerfstudioKeyframes(const std::string& path)
   }
   std::vector<CameraPathKeyframe> keys;
   try {
-    const int render_w = json.value("render_width", 0);
-    const int render_h = json.value("render_height", 0);
+    // An optional size: `fallback` when absent; present, it must be a size.
+    auto size_of = [&](const nlohmann::json& object, const char* key, int fallback,
+                       const std::string& where) {
+      int size = fallback;
+      if (!object.contains(key)) return size;
+      Require(JsonToInt(object[key], 0, 99999, &size), path,
+              where + key + " must be a whole number in 0..99999");
+      return size;
+    };
+    const int render_w = size_of(json, "render_width", 0, "");
+    const int render_h = size_of(json, "render_height", 0, "");
     const auto& list = json["keyframes"];
     for (size_t i = 0; i < list.size(); ++i) {
       const auto& k = list[i];
@@ -154,11 +164,14 @@ std::vector<CameraPathKeyframe> ReadNerfstudioKeyframes(const std::string& path)
       const double fov = k.at("fov").get<double>();
       Require(std::isfinite(fov) && fov > 0 && fov < 180, path,
               where + ": fov must be in (0, 180) degrees");
-      const int height = k.value("height", render_h);
+      const int height = size_of(k, "height", render_h, where + ": ");
       double aspect = k.value("aspect", render_h > 0 ? 1.0 * render_w / render_h : 0.0);
-      int width = k.value("width", 0);
-      if (width <= 0)
-        width = render_w > 0 ? render_w : static_cast<int>(std::lround(aspect * height));
+      int width = size_of(k, "width", 0, where + ": ");
+      if (width <= 0 && render_w > 0) width = render_w;
+      // Checked before the cast: a huge or non-finite aspect has no int width.
+      if (width <= 0 && aspect > 0 && aspect * height < 100000) {
+        width = static_cast<int>(std::lround(aspect * height));
+      }
       Require(width > 0 && height > 0 && width < 100000 && height < 100000, path,
               where + ": no usable size (render_width/height or width/height)");
       CameraPathKeyframe key;

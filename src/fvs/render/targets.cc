@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include "fvs/scene/scene.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
+#include "fvs/util/json_number.h"
 #include "fvs/util/string_util.h"
 
 namespace fvs {
@@ -32,6 +34,17 @@ bool ParseDoubles(const std::vector<std::string>& tokens, size_t first, size_t c
       return false;
     }
   }
+  return true;
+}
+
+// A COLMAP id: all of `token` a whole number that fits uint32_t. (Parsed as a double
+// and cast, 1e20 or -1 was undefined behaviour: tests/fuzz/target_images_fuzzer.)
+bool ParseId(const std::string& token, uint32_t* id) {
+  uint32_t value = 0;
+  const char* end = token.data() + token.size();
+  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
+  if (ec != std::errc() || ptr != end) return false;
+  *id = value;
   return true;
 }
 
@@ -65,7 +78,8 @@ std::map<uint32_t, PinholeCamera> ReadPinholeCamerasTxt(const std::string& path)
                 " has distortion; targets must be SIMPLE_PINHOLE or PINHOLE");
     const int num_params = colmap::CameraModelNumParams(model);
     double v[3 + 4];
-    Require(ParseDoubles(tokens, 0, 1, v) && ParseDoubles(tokens, 2, 2, v + 1) &&
+    uint32_t camera_id = 0;
+    Require(ParseId(tokens[0], &camera_id) && ParseDoubles(tokens, 2, 2, v + 1) &&
                 ParseDoubles(tokens, 4, num_params, v + 3) &&
                 static_cast<int>(tokens.size()) == 4 + num_params,
             path, where + ": malformed camera line");
@@ -87,7 +101,7 @@ std::map<uint32_t, PinholeCamera> ReadPinholeCamerasTxt(const std::string& path)
     Require(c.fx > 0 && c.fy > 0 && std::isfinite(c.fx) && std::isfinite(c.fy) &&
                 std::isfinite(c.cx) && std::isfinite(c.cy),
             path, where + ": focal lengths must be positive and finite");
-    cameras[static_cast<uint32_t>(v[0])] = c;
+    cameras[camera_id] = c;
   }
   return cameras;
 }
@@ -152,15 +166,16 @@ std::vector<TargetCamera> ReadTargetImagesTxt(const std::string& path,
     }
     if (trimmed.empty() || trimmed[0] == '#') continue;
     const std::string where = "line " + std::to_string(line_number);
-    double v[9];
-    Require(tokens.size() >= 10 && ParseDoubles(tokens, 0, 9, v), path,
-            where + ": expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME");
+    double v[8];
+    uint32_t camera_id = 0;
+    Require(tokens.size() >= 10 && ParseDoubles(tokens, 0, 8, v) &&
+                ParseId(tokens[8], &camera_id),
+            path, where + ": expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME");
     for (int i = 1; i < 8; ++i) {
       Require(std::isfinite(v[i]), path, where + ": non-finite pose");
     }
     const Eigen::Vector4d q(v[1], v[2], v[3], v[4]);
     Require(q.norm() > 1e-12, path, where + ": zero quaternion");
-    const uint32_t camera_id = static_cast<uint32_t>(v[8]);
     PinholeCamera camera;
     if (cameras.count(camera_id)) {
       camera = cameras[camera_id];
@@ -199,10 +214,10 @@ std::vector<TargetCamera> ReadNerfstudioCameraPath(const std::string& path) {
   }
   std::vector<TargetCamera> targets;
   try {
-    const int width = json.at("render_width").get<int>();
-    const int height = json.at("render_height").get<int>();
-    Require(width > 0 && height > 0 && width < 100000 && height < 100000, path,
-            "render_width and render_height must be positive");
+    int width = 0, height = 0;
+    Require(JsonToInt(json.at("render_width"), 1, 99999, &width) &&
+                JsonToInt(json.at("render_height"), 1, 99999, &height),
+            path, "render_width and render_height must be positive whole numbers");
     const auto& frames = json.at("camera_path");
     Require(frames.is_array() && !frames.empty(), path, "camera_path is empty");
     for (size_t i = 0; i < frames.size(); ++i) {
