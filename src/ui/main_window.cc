@@ -32,7 +32,7 @@ namespace fvs::ui {
 namespace {
 
 bool MethodNeedsWeights(const std::string& method) {
-  return method != "ulr" && method != "nearest";
+  return TraitsOfMethod(method).needs_weights;
 }
 
 // Default output size: the first camera's, at most 640 pixels wide (a few seconds per
@@ -202,7 +202,7 @@ QWidget* MainWindow::BuildControls() {
   num_sources_->setObjectName("num_sources");
   num_sources_->setRange(0, 16);
   num_sources_->setSpecialValueText("auto");  // 0: adaptive K (RenderOptions)
-  num_sources_->setValue(0);  // auto
+  num_sources_->setValue(0);                  // auto
   form->addRow("Sources (K)", num_sources_);
   auto* size_row = new QHBoxLayout();
   width_ = new QSpinBox(render_box);

@@ -273,6 +273,21 @@ TEST(MethodRegistryTest, KnownMethodsAndClearErrors) {
   RegisterMethod("constant",
                  [](const RenderOptions&) { return std::make_unique<Constant>(); });
   EXPECT_EQ(CreateMethod("constant", RenderOptions{})->name(), "constant");
+  // What each method needs is declared with it: the classical ones no weights, `nearest`
+  // one source, every network variant weights; a registered method keeps its traits.
+  EXPECT_FALSE(TraitsOfMethod("ulr").needs_weights);
+  EXPECT_FALSE(TraitsOfMethod("ulr").single_source);
+  EXPECT_FALSE(TraitsOfMethod("nearest").needs_weights);
+  EXPECT_TRUE(TraitsOfMethod("nearest").single_source);
+  EXPECT_TRUE(TraitsOfMethod("fvs").needs_weights);
+  EXPECT_TRUE(TraitsOfMethod("fvs_agg").needs_weights);
+  EXPECT_FALSE(TraitsOfMethod("constant").needs_weights);
+  MethodTraits learned;
+  learned.needs_weights = true;
+  RegisterMethod(
+      "learned_constant",
+      [](const RenderOptions&) { return std::make_unique<Constant>(); }, learned);
+  EXPECT_TRUE(TraitsOfMethod("learned_constant").needs_weights);
 }
 
 TEST(RenderTest, InvalidTargetCameraIsAnError) {

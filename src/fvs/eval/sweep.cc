@@ -4,6 +4,7 @@
 #include <map>
 
 #include "fvs/net/model_config.h"
+#include "fvs/render/method.h"
 #include "fvs/util/error.h"
 #include "fvs/util/safetensors.h"
 #include "fvs/util/string_util.h"
@@ -18,10 +19,6 @@ std::vector<std::string> Items(const std::string& list) {
     if (!trimmed.empty()) items.push_back(trimmed);
   }
   return items;
-}
-
-bool IsNetworkMethod(const std::string& method) {
-  return method != "ulr" && method != "nearest";
 }
 
 }  // namespace
@@ -78,7 +75,7 @@ SweepPlan PlanSweep(const SweepOptions& options) {
   const std::vector<double> scales = ParseDoubleList(options.scales, "--sweep_scales");
   for (const std::string& method : Items(options.methods)) {
     std::string model_path;
-    if (IsNetworkMethod(method)) {
+    if (TraitsOfMethod(method).needs_weights) {
       if (method == "fvs" && !weights.empty() && !weights.count("fvs")) {
         // "fvs" accepts any variant; but each file is swept under its own name below.
         plan.notes.push_back(
@@ -100,10 +97,11 @@ SweepPlan PlanSweep(const SweepOptions& options) {
       if (model_path.empty() && precision != "fp32") continue;
       for (double scale : scales) {
         for (int k : ks) {
-          if (method == "nearest" && k != ks.front()) continue;
+          const bool one_source = TraitsOfMethod(method).single_source;
+          if (one_source && k != ks.front()) continue;
           EvalConfig c;
           c.method = method;
-          c.num_sources = method == "nearest" ? 1 : k;
+          c.num_sources = one_source ? 1 : k;
           c.scale = scale;
           c.precision = precision;
           c.model_path = model_path;

@@ -81,9 +81,14 @@ class HoleFillingMethod : public Method {
   std::unique_ptr<Method> inner_;
 };
 
+struct Registered {
+  MethodFactory factory;
+  MethodTraits traits;
+};
+
 struct Registry {
   std::mutex mutex;
-  std::map<std::string, MethodFactory> factories;
+  std::map<std::string, Registered> methods;
 };
 
 // The built-ins are registered here, not by static objects: a static archive would let
@@ -91,13 +96,18 @@ struct Registry {
 Registry& GetRegistry() {
   static Registry* registry = [] {
     auto* r = new Registry;
-    r->factories["ulr"] = CreateUlrMethod;
-    r->factories["nearest"] = CreateNearestMethod;
+    r->methods["ulr"] = {CreateUlrMethod, {}};
+    MethodTraits one_source;
+    one_source.single_source = true;
+    r->methods["nearest"] = {CreateNearestMethod, one_source};
     // The network under its generic name and under each variant name.
+    MethodTraits network;
+    network.needs_weights = true;
     for (const std::string& variant : ModelConfig::KnownVariants()) {
-      r->factories[variant] = [variant](const RenderOptions& options) {
-        return CreateFvsMethod(variant, options);
-      };
+      r->methods[variant] = {[variant](const RenderOptions& options) {
+                               return CreateFvsMethod(variant, options);
+                             },
+                             network};
     }
     return r;
   }();
@@ -106,17 +116,27 @@ Registry& GetRegistry() {
 
 }  // namespace
 
-void RegisterMethod(const std::string& name, MethodFactory factory) {
+void RegisterMethod(const std::string& name, MethodFactory factory, MethodTraits traits) {
   Registry& registry = GetRegistry();
   std::lock_guard<std::mutex> lock(registry.mutex);
-  registry.factories[name] = std::move(factory);
+  registry.methods[name] = {std::move(factory), traits};
+}
+
+MethodTraits TraitsOfMethod(const std::string& name) {
+  Registry& registry = GetRegistry();
+  std::lock_guard<std::mutex> lock(registry.mutex);
+  const auto it = registry.methods.find(name);
+  if (it != registry.methods.end()) return it->second.traits;
+  MethodTraits network;
+  network.needs_weights = true;
+  return network;
 }
 
 std::vector<std::string> RegisteredMethods() {
   Registry& registry = GetRegistry();
   std::lock_guard<std::mutex> lock(registry.mutex);
   std::vector<std::string> names;
-  for (const auto& [name, factory] : registry.factories) names.push_back(name);
+  for (const auto& [name, method] : registry.methods) names.push_back(name);
   return names;
 }
 
@@ -130,8 +150,8 @@ std::unique_ptr<Method> CreateMethod(const std::string& name,
   {
     Registry& registry = GetRegistry();
     std::lock_guard<std::mutex> lock(registry.mutex);
-    const auto it = registry.factories.find(name);
-    if (it != registry.factories.end()) factory = it->second;
+    const auto it = registry.methods.find(name);
+    if (it != registry.methods.end()) factory = it->second.factory;
   }
   if (!factory) {
     if (name == "fvs") {

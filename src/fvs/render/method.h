@@ -128,8 +128,23 @@ class Method {
 
 using MethodFactory = std::function<std::unique_ptr<Method>(const RenderOptions&)>;
 
+// What a method needs and does beyond the shared front end, declared once where it is
+// registered, so that the commands, the sweep and the GUI ask here instead of testing
+// names.
+struct MethodTraits {
+  // A network: weights from --model_path, the scene's fine-tuned ones or the shipped
+  // model (RenderOptions::model_path, scene_model_dir).
+  bool needs_weights = false;
+  // Renders from one source whatever K (`nearest`): a sweep over K runs it once, at K 1.
+  bool single_source = false;
+};
+
 // Adds (or replaces) a method. Thread-safe.
-void RegisterMethod(const std::string& name, MethodFactory factory);
+void RegisterMethod(const std::string& name, MethodFactory factory,
+                    MethodTraits traits = {});
+// The traits a method was registered with. A name that is not registered can only be a
+// network this build lacks (CreateMethod says so): it needs weights.
+MethodTraits TraitsOfMethod(const std::string& name);
 // Names of the available methods, sorted; `ulr` and `nearest` are always there.
 std::vector<std::string> RegisteredMethods();
 // A workspace's folder for encoded source features (RenderOptions::feature_cache_dir):
