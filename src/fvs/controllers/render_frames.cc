@@ -119,10 +119,16 @@ class FrameLoop {
 
 }  // namespace
 
+void RenderFramesOptions::Check() const {
+  Require(!output_path.empty(), "RenderFrames", "no output folder given");
+  temporal.Check();
+}
+
 RenderFramesResult RenderFrames(const Scene& scene, Method* method,
                                 const std::vector<RenderFrame>& frames,
                                 const RenderFramesOptions& options,
                                 const RenderFramesCallbacks& callbacks) {
+  options.Check();
   FrameLoop loop(scene, method, frames, options);
   for (size_t k = 0; k < frames.size(); ++k) {
     if (callbacks.cancelled && callbacks.cancelled()) break;

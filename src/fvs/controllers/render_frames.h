@@ -43,6 +43,9 @@ struct RenderFramesOptions {
   std::string report_extra_json;  // merged into the report's JSON summary
   // The rows of an earlier report by frame name: resumed frames keep theirs.
   std::map<std::string, FrameReportRow> earlier;
+
+  // Throws fvs::Error with one line: no output folder, or temporal options out of range.
+  void Check() const;
 };
 
 struct RenderFramesCallbacks {
@@ -66,8 +69,9 @@ struct RenderFramesResult {
   FrameReportSummary summary;
 };
 
-// Renders `frames` of `scene` with `method` in order. Throws fvs::Error for an invalid
-// target camera or a failed render or write (the frames before it are on disk).
+// Renders `frames` of `scene` with `method` in order. Throws fvs::Error for bad options
+// (before any frame), an invalid target camera or a failed render or write (the frames
+// before it are on disk).
 RenderFramesResult RenderFrames(const Scene& scene, Method* method,
                                 const std::vector<RenderFrame>& frames,
                                 const RenderFramesOptions& options,
