@@ -374,8 +374,9 @@ void PathPanel::RenderPath() {
         render_options.stable_source_order = true;
         std::unique_ptr<Method> method = CreateMethod(request.method, render_options);
         const int n = static_cast<int>(frames.size());
-        // The command line's frame loop (controllers/render_frames.h), without resuming
-        // or a report: every frame is rendered anew into the chosen folder.
+        // The command line's frame loop (controllers/render_frames.h), without resuming,
+        // a report or the flicker it would show: every frame is rendered anew into the
+        // chosen folder.
         std::vector<RenderFrame> jobs;
         std::vector<std::string> frame_paths;
         for (const TargetCamera& frame : frames) {
@@ -385,6 +386,7 @@ void PathPanel::RenderPath() {
         RenderFramesOptions frame_options;
         frame_options.output_path = out;
         frame_options.method = request.method;
+        frame_options.temporal.measure_flicker = false;  // no report: as fast as before
         RenderFramesCallbacks callbacks;
         callbacks.cancelled = [&control] { return control.cancelled.load(); };
         callbacks.before_frame = [&report, n](size_t i) {

@@ -101,6 +101,21 @@ TEST(RenderFrames, StopsBetweenFramesWhenCancelledAndWritesNoReportWithoutAStem)
   EXPECT_FALSE(std::filesystem::exists(dir / "frame_report.csv"));
 }
 
+TEST(RenderFrames, FlickerIsLeftUnmeasuredWhenNotAskedFor) {
+  const Scene scene = MakeTestScene(5, 48, 36);
+  TempDir dir;
+  RenderFramesOptions options;
+  options.output_path = dir.path();
+  options.method = "ulr";
+  options.temporal.measure_flicker = false;  // the GUI's path render
+  std::unique_ptr<Method> method = CreateMethod("ulr", {});
+  const RenderFramesResult result =
+      RenderFrames(scene, method.get(), ArcFrames(2), options);
+  ASSERT_EQ(result.report.size(), 2u);
+  EXPECT_LT(result.report[1].flicker, 0);
+  EXPECT_GE(result.report[1].source_changes, 0);  // the chain itself goes on
+}
+
 TEST(RenderFrames, AnInvalidCameraFailsAtItsFrameAfterTheFramesBefore) {
   const Scene scene = MakeTestScene(5, 48, 36);
   TempDir dir;
