@@ -13,9 +13,9 @@
 #include <filesystem>
 
 #include "colmap_ext/workspace.h"
+#include "fvs/controllers/render_frames.h"
 #include "fvs/path/video.h"
 #include "fvs/render/method.h"
-#include "fvs/render/render_output.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
 #include "fvs/util/progress.h"
@@ -374,24 +374,27 @@ void PathPanel::RenderPath() {
         render_options.stable_source_order = true;
         std::unique_ptr<Method> method = CreateMethod(request.method, render_options);
         const int n = static_cast<int>(frames.size());
-        std::vector<int> previous_sources;
+        // The command line's frame loop (controllers/render_frames.h), without resuming,
+        // a report or the flicker it would show: every frame is rendered anew into the
+        // chosen folder.
+        std::vector<RenderFrame> jobs;
         std::vector<std::string> frame_paths;
-        for (int i = 0; i < n; ++i) {
-          if (control.cancelled) break;  // the continuation is dropped anyway
-          report(i, n, QString("Frame %1 of %2").arg(i + 1).arg(n));
-          TargetView target;
-          target.name = frames[i].name;
-          target.camera = scene.ToSceneCamera(frames[i].camera);
-          target.preferred_sources = previous_sources;
-          Require(target.camera.IsValid(), frames[i].name, "invalid path camera");
-          const RenderResult result = method->Render(scene, target);
-          WriteRenderOutputs(out, frames[i].name, request.method, scene, result, {});
-          frame_paths.push_back(out + "/" + frames[i].name + ".png");
-          previous_sources.clear();
-          for (const SourceScore& source : result.sources) {
-            previous_sources.push_back(source.view_index);
-          }
+        for (const TargetCamera& frame : frames) {
+          jobs.push_back({frame, false});
+          frame_paths.push_back(out + "/" + frame.name + ".png");
         }
+        RenderFramesOptions frame_options;
+        frame_options.output_path = out;
+        frame_options.method = request.method;
+        frame_options.temporal.measure_flicker = false;  // no report: as fast as before
+        RenderFramesCallbacks callbacks;
+        callbacks.cancelled = [&control] { return control.cancelled.load(); };
+        callbacks.before_frame = [&report, n](size_t i) {
+          report(static_cast<int>(i), n, QString("Frame %1 of %2").arg(i + 1).arg(n));
+        };
+        const RenderFramesResult rendered =
+            RenderFrames(scene, method.get(), jobs, frame_options, callbacks);
+        frame_paths.resize(rendered.rendered.size());
         report(n, n, "Encoding the video");
         const QString video =
             control.cancelled ? QString() : MakeVideo(frame_paths, out, options.fps);

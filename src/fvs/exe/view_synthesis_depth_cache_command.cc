@@ -2,14 +2,11 @@
 // view from W/meshed-delaunay.ply into W/fvs/depth/ (reusing what is current). The last
 // stage of view_synthesis_prepare; on its own after a mesh was replaced. Prints how much
 // of the photos the mesh covers and writes it per view to W/fvs/depth/coverage.json.
-#include <iostream>
+#include <string>
 
+#include "fvs/controllers/workspace_stages.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/option_manager.h"
-#include "fvs/scene/mesh_coverage.h"
-#include "fvs/scene/scene.h"
-#include "fvs/util/atomic_file.h"
-#include "fvs/util/progress.h"
 
 namespace fvs {
 namespace {
@@ -23,19 +20,7 @@ int RunDepthCache(int argc, char** argv) {
   options.AddRequired("workspace_path", &workspace_path, "dense workspace");
   options.AddDefault("num_threads", &num_threads, "-1 = all cores");
   if (!options.Parse(argc, argv)) return 0;
-  SceneLoadOptions load;
-  load.use_depth_cache = true;
-  load.num_threads = num_threads;
-  Timer timer;
-  const Scene scene = Scene::Load(workspace_path, load);
-  std::cerr << "depth cache: " << scene.num_views() << " views, "
-            << scene.num_depths_computed() << " rendered, "
-            << scene.num_views() - scene.num_depths_computed() << " reused, "
-            << timer.Seconds() << " s\n";
-  const MeshCoverage coverage = MeasureMeshCoverage(scene);
-  std::cerr << coverage.Summary() << "\n";
-  WriteFileAtomic(scene.workspace_path() + "/fvs/depth/coverage.json",
-                  [&](std::ostream& out) { out << coverage.ToJson() << "\n"; });
+  BuildDepthCache(workspace_path, num_threads);
   return 0;
 }
 

@@ -6,14 +6,13 @@
 // options of COLMAP's delaunay_mesher (--DelaunayMeshing.*, same names and defaults), for
 // the COLMAP builds that lack CGAL (Debian's). Bad input: one error line, exit 1, no
 // output.
-#include <iostream>
 #include <string>
 
 #include "colmap_ext/workspace.h"
+#include "fvs/controllers/workspace_stages.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/option_manager.h"
 #include "fvs/mvs/delaunay.h"
-#include "fvs/util/error.h"
 
 namespace fvs {
 namespace {
@@ -72,19 +71,7 @@ int RunViewSynthesisMesher(int argc, char** argv) {
   }
   o.Check();
 
-  if constexpr (!mvs::DelaunayMesherAvailable()) {
-    throw Error(
-        "colmap view_synthesis_mesher",
-        "the built-in Delaunay mesher is unavailable: this build has no CGAL or "
-        "Boost.Graph (install libcgal-dev and libboost-graph-dev and rebuild), or use "
-        "a COLMAP built with CGAL: colmap delaunay_mesher");
-  }
-#ifdef FVS_HAVE_CGAL
-  const mvs::DelaunayMeshingStats stats =
-      mvs::DenseDelaunayMeshing(workspace_path, output_path, o);
-  std::cout << "Delaunay mesher: " << stats.Summary() << "\n"
-            << "Wrote " << output_path << std::endl;
-#endif
+  RunBuiltinMesher(workspace_path, output_path, o);
   return 0;
 }
 

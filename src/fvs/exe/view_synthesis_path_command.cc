@@ -34,6 +34,25 @@ void PrintStats(const char* label, const CameraPathStats& s, double fps) {
   std::printf("\n");
 }
 
+// The keyframes of --keyframes_path, else the registered images named in --keyframes,
+// else every registered image by name.
+std::vector<CameraPathKeyframe> ChooseKeyframes(const Scene& scene,
+                                                const std::string& keyframes,
+                                                const std::string& keyframes_path) {
+  if (!keyframes_path.empty()) {
+    return ReadNerfstudioKeyframes(keyframes_path);
+  }
+  std::vector<std::string> names;
+  for (const std::string& n : SplitString(keyframes, ",")) {
+    if (!TrimString(n).empty()) names.push_back(TrimString(n));
+  }
+  if (names.empty()) {
+    for (const SceneView& v : scene.views()) names.push_back(v.name);
+    std::sort(names.begin(), names.end());
+  }
+  return KeyframesFromScene(scene, names);
+}
+
 int RunViewSynthesisPath(int argc, char** argv) {
   std::string workspace_path, output_path, keyframes, keyframes_path, images_txt;
   CameraPathOptions o;
@@ -89,20 +108,8 @@ int RunViewSynthesisPath(int argc, char** argv) {
 
   Timer timer;
   Scene scene = Scene::Load(workspace_path);
-  std::vector<CameraPathKeyframe> keys;
-  if (!keyframes_path.empty()) {
-    keys = ReadNerfstudioKeyframes(keyframes_path);
-  } else {
-    std::vector<std::string> names;
-    for (const std::string& n : SplitString(keyframes, ",")) {
-      if (!TrimString(n).empty()) names.push_back(TrimString(n));
-    }
-    if (names.empty()) {
-      for (const SceneView& v : scene.views()) names.push_back(v.name);
-      std::sort(names.begin(), names.end());
-    }
-    keys = KeyframesFromScene(scene, names);
-  }
+  const std::vector<CameraPathKeyframe> keys =
+      ChooseKeyframes(scene, keyframes, keyframes_path);
   const double load_s = timer.Seconds();
   timer.Restart();
   const CameraPathResult r = ComputeCameraPath(keys, o, use_scene ? &scene : nullptr);

@@ -1,69 +1,17 @@
 // colmap view_synthesis_prepare --image_path P --workspace_path W
 //
-// Photos -> ready scene: feature extraction, matching, mapping, undistortion (COLMAP),
-// dense stereo (COLMAP's when it has CUDA, else ours), fusion (COLMAP), meshing (COLMAP's
-// when it has CGAL, else ours), source depth cache. Each stage records a fingerprint of
-// its inputs and options in W/fvs/manifest.json and is skipped when that is unchanged and
-// its outputs exist. Fingerprints chain (a stage's includes the one before it), so
-// changing an early stage re-runs everything after it. Stages write into W/fvs/tmp/ and
-// rename into place, so kill -9 at any point loses at most the stage that was running.
-#include <algorithm>
-#include <filesystem>
-#include <fstream>
-#include <iostream>
-#include <map>
-#include <set>
-#include <sstream>
-#include <string>
-#include <vector>
-
-#include "colmap_ext/reconstruction.h"
-#include "colmap_ext/runner.h"
-#include "colmap_ext/sparse_io.h"
-#include "colmap_ext/workspace.h"
+// Photos -> ready scene: SfM, undistortion, dense stereo, fusion, meshing, source depth
+// cache, each stage skipped when it is current and a killed run resumed: PrepareWorkspace
+// (controllers/prepare_workspace.h) does the work and states the rules.
+#include "fvs/controllers/prepare_workspace.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/option_manager.h"
-#include "fvs/exe/prepare_stages.h"
-#include "fvs/util/error.h"
-#include "fvs/util/manifest.h"
-#include "fvs/util/progress.h"
-#include "fvs/util/string_util.h"
 
 namespace fvs {
 namespace {
-namespace fs = std::filesystem;
-
-struct PrepareOptions {
-  std::string image_path;
-  std::string workspace_path;
-  std::string matcher = "auto";  // auto | exhaustive | sequential
-  std::string camera_model = "SIMPLE_RADIAL";
-  bool single_camera = true;
-  int max_image_size = 1600;            // SIFT and undistortion
-  std::string stereo_backend = "auto";  // auto | colmap | builtin
-  std::string mesher_backend = "auto";  // auto | colmap | builtin
-  int stereo_max_image_size = 0;        // 0 = full undistorted size
-  std::string holdout_images;  // file with one image name per line, or comma list
-  int num_threads = -1;
-
-  void Check() const {
-    const std::string who = "colmap view_synthesis_prepare";
-    Require(
-        matcher == "auto" || matcher == "exhaustive" || matcher == "sequential", who,
-        "--Matching.type must be auto, exhaustive or sequential, not '" + matcher + "'");
-    Require(stereo_backend == "auto" || stereo_backend == "colmap" ||
-                stereo_backend == "builtin",
-            who, "--Stereo.backend must be auto, colmap or builtin");
-    Require(mesher_backend == "auto" || mesher_backend == "colmap" ||
-                mesher_backend == "builtin",
-            who, "--Mesher.backend must be auto, colmap or builtin");
-    Require(max_image_size > 0, who, "--max_image_size must be positive");
-    Require(stereo_max_image_size >= 0, who, "--Stereo.max_image_size must be >= 0");
-  }
-};
 
 int RunPrepare(int argc, char** argv) {
-  PrepareOptions o;
+  PrepareWorkspaceOptions o;
   OptionManager options(
       "view_synthesis_prepare",
       "Photos to a ready view-synthesis scene: SfM, undistortion, dense "
@@ -94,21 +42,7 @@ int RunPrepare(int argc, char** argv) {
       "a file with one name per line, or a comma-separated list");
   options.AddDefault("num_threads", &o.num_threads, "-1 = all cores");
   if (!options.Parse(argc, argv)) return 0;
-  o.Check();
-
-  PrepareContext context;
-  context.image_path = fs::absolute(o.image_path).lexically_normal().string();
-  context.workspace_path = fs::absolute(o.workspace_path).lexically_normal().string();
-  context.matcher = o.matcher;
-  context.camera_model = o.camera_model;
-  context.single_camera = o.single_camera;
-  context.max_image_size = o.max_image_size;
-  context.stereo_backend = o.stereo_backend;
-  context.mesher_backend = o.mesher_backend;
-  context.stereo_max_image_size = o.stereo_max_image_size;
-  context.holdout = ParseHoldoutList(o.holdout_images);
-  context.num_threads = o.num_threads;
-  RunPrepareStages(context);
+  PrepareWorkspace(o);
   return 0;
 }
 

@@ -23,44 +23,10 @@ namespace {
 
 using namespace eval;  // NOLINT: the command is a thin layer over fvs::eval
 
-int RunViewSynthesisStability(int argc, char** argv) {
-  StabilityOptions o;
-  std::string methods = "nearest,ulr";
-  std::string output_path;
-  OptionManager options("view_synthesis_stability",
-                        "The renderer's numerical stability suite: depth 0, depth 1e30, "
-                        "target behind every source, a source seen edge-on, a single "
-                        "source, K larger than the scene, each also 10 km from the "
-                        "origin.");
-  options.AddDefault("methods", &methods,
-                     "comma-separated methods (network variants need --model_path; "
-                     "random weights are fine for this suite)");
-  options.AddDefault("model_path", &o.model_path, "network weights");
-  options.AddDefault("precision", &o.precision,
-                     "network methods: fp32, bf16, or fp16 (CUDA only)");
-  options.AddDefault("tile_size", &o.tile_size,
-                     "network methods: blend in tiles of at most this size (0: never)");
-  options.AddDefault("width", &o.width, "target and source width");
-  options.AddDefault("height", &o.height, "target and source height");
-  options.AddDefault("far_offset", &o.far_offset_m, "distance of the far copy (m)");
-  options.AddDefault("output_path", &output_path,
-                     "folder for stability.csv and stability.md (optional)");
-  options.AddDefault("num_threads", &o.num_threads, "threads (0: all cores)");
-  if (!options.Parse(argc, argv)) return 0;
-  Require(o.width >= 16 && o.height >= 16 && o.width <= 4096 && o.height <= 4096,
-          "--width/--height", "must be in [16, 4096]");
-  Require(o.far_offset_m >= 0 && o.far_offset_m < 1e8, "--far_offset",
-          "must be in [0, 1e8)");
-  o.methods.clear();
-  for (const std::string& m : SplitString(methods, ",")) {
-    if (!TrimString(m).empty()) o.methods.push_back(TrimString(m));
-  }
-  Require(!o.methods.empty(), "--methods", "empty list");
-  RenderOptions probe;
-  probe.model_path = o.model_path;
-  for (const std::string& m : o.methods) CreateMethod(m, probe);  // fail early
-
-  const std::vector<StabilityResult> results = RunStabilitySuite(o);
+// Prints the table of `results` and, with an output folder, writes it as stability.csv
+// and stability.md there. Returns how many cases failed.
+int ReportStabilityResults(const std::vector<StabilityResult>& results,
+                           const StabilityOptions& o, const std::string& output_path) {
   const std::string machine = DescribeMachine();
   char header[256];
   std::snprintf(header, sizeof(header), "%-15s %-10s %7s %7s %8s %11s %9s %8s %s", "case",
@@ -108,6 +74,48 @@ int RunViewSynthesisStability(int argc, char** argv) {
       out << "# Stability suite\n\n- machine: " << machine << "\n\n" << md;
     });
   }
+  return failed;
+}
+
+int RunViewSynthesisStability(int argc, char** argv) {
+  StabilityOptions o;
+  std::string methods = "nearest,ulr";
+  std::string output_path;
+  OptionManager options("view_synthesis_stability",
+                        "The renderer's numerical stability suite: depth 0, depth 1e30, "
+                        "target behind every source, a source seen edge-on, a single "
+                        "source, K larger than the scene, each also 10 km from the "
+                        "origin.");
+  options.AddDefault("methods", &methods,
+                     "comma-separated methods (network variants need --model_path; "
+                     "random weights are fine for this suite)");
+  options.AddDefault("model_path", &o.model_path, "network weights");
+  options.AddDefault("precision", &o.precision,
+                     "network methods: fp32, bf16, or fp16 (CUDA only)");
+  options.AddDefault("tile_size", &o.tile_size,
+                     "network methods: blend in tiles of at most this size (0: never)");
+  options.AddDefault("width", &o.width, "target and source width");
+  options.AddDefault("height", &o.height, "target and source height");
+  options.AddDefault("far_offset", &o.far_offset_m, "distance of the far copy (m)");
+  options.AddDefault("output_path", &output_path,
+                     "folder for stability.csv and stability.md (optional)");
+  options.AddDefault("num_threads", &o.num_threads, "threads (0: all cores)");
+  if (!options.Parse(argc, argv)) return 0;
+  Require(o.width >= 16 && o.height >= 16 && o.width <= 4096 && o.height <= 4096,
+          "--width/--height", "must be in [16, 4096]");
+  Require(o.far_offset_m >= 0 && o.far_offset_m < 1e8, "--far_offset",
+          "must be in [0, 1e8)");
+  o.methods.clear();
+  for (const std::string& m : SplitString(methods, ",")) {
+    if (!TrimString(m).empty()) o.methods.push_back(TrimString(m));
+  }
+  Require(!o.methods.empty(), "--methods", "empty list");
+  RenderOptions probe;
+  probe.model_path = o.model_path;
+  for (const std::string& m : o.methods) CreateMethod(m, probe);  // fail early
+
+  const std::vector<StabilityResult> results = RunStabilitySuite(o);
+  const int failed = ReportStabilityResults(results, o, output_path);
   Require(failed == 0, "view_synthesis_stability",
           std::to_string(failed) + " of " + std::to_string(results.size()) +
               " cases failed (see the table above)");

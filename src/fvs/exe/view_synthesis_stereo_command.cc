@@ -6,9 +6,9 @@
 //                        --input_type geometric --output_path W/fused.ply
 // fuses them unchanged. Images whose maps exist are skipped unless
 // --PatchMatchStereo.overwrite 1 (a killed run resumes where it stopped).
-#include <iostream>
 #include <string>
 
+#include "fvs/controllers/workspace_stages.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/option_manager.h"
 #include "fvs/mvs/patch_match_stereo.h"
@@ -81,13 +81,7 @@ int RunViewSynthesisStereo(int argc, char** argv) {
   pm.seed = static_cast<uint64_t>(seed);
   if (stereo.max_image_size < 0) stereo.max_image_size = 0;  // COLMAP's -1 = full size
 
-  const mvs::PatchMatchStereoSummary summary =
-      mvs::RunPatchMatchStereo(workspace_path, stereo);
-  std::cerr << "stereo: " << summary.num_problems << " images, "
-            << summary.num_photometric_computed << " photometric and "
-            << summary.num_geometric_computed << " geometric maps computed, "
-            << summary.num_skipped << " already done, " << summary.num_without_depth_range
-            << " without depth range; " << summary.seconds << " s" << std::endl;
+  RunBuiltinStereo(workspace_path, stereo);
   return 0;
 }
 

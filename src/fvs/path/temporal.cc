@@ -72,6 +72,8 @@ FrameReportRow TemporalSequence::Finish(const TargetView& view, RenderResult* re
       row.source_changes += std::find(previous_sources_.begin(), previous_sources_.end(),
                                       s) == previous_sources_.end();
     }
+  }
+  if (chain && options_.measure_flicker) {
     const FlickerPair pair = MeasureFlicker(
         previous_color_, previous_depth_, previous_camera_, result->color, result->depth,
         view.camera, options_.flicker, &previous_coverage_, &result->coverage);

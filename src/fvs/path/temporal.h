@@ -21,6 +21,9 @@ struct TemporalOptions {
   double temporal_blend = 0;  // in [0, 1): share of the warped previous output
   bool use_preferred_sources = true;
   double coverage_threshold = 0.5;  // frames under it are flagged
+  // Measure each frame's flicker to the previous one (a warp of the previous frame into
+  // it, for the report): off where no report is read, so that it costs nothing there.
+  bool measure_flicker = true;
   FlickerOptions flicker;
   void Check() const;
 };

@@ -1,4 +1,6 @@
-// The stages of view_synthesis_prepare (see view_synthesis_prepare_command.cc).
+// The decisions of view_synthesis_prepare's stages (prepare_workspace.h) that do not
+// need COLMAP: which photos and holdouts, which matcher and pairs, when to retry, the
+// stereo configurations and the check of what undistortion made.
 #pragma once
 
 #include <set>
@@ -8,20 +10,6 @@
 #include "colmap_ext/reconstruction.h"
 
 namespace fvs {
-
-struct PrepareContext {
-  std::string image_path;      // absolute
-  std::string workspace_path;  // absolute
-  std::string matcher = "auto";
-  std::string camera_model = "SIMPLE_RADIAL";
-  bool single_camera = true;
-  int max_image_size = 1600;
-  std::string stereo_backend = "auto";
-  std::string mesher_backend = "auto";
-  int stereo_max_image_size = 0;
-  std::set<std::string> holdout;
-  int num_threads = -1;
-};
 
 // "a.jpg,b.jpg" or the path of a file with one name per line; empty -> empty set.
 std::set<std::string> ParseHoldoutList(const std::string& spec);
@@ -75,7 +63,5 @@ void WriteStereoConfigs(const std::string& workspace_path,
 std::vector<std::string> ShrunkenUndistortionWarnings(
     const colmap::Reconstruction& sfm, const colmap::Reconstruction& undistorted,
     int max_image_size);
-
-void RunPrepareStages(const PrepareContext& context);
 
 }  // namespace fvs

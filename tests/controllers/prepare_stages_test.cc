@@ -1,4 +1,4 @@
-#include "fvs/exe/prepare_stages.h"
+#include "fvs/controllers/prepare_stages.h"
 
 #include <gtest/gtest.h>
 

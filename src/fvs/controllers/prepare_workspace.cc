@@ -1,0 +1,289 @@
+#include "fvs/controllers/prepare_workspace.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <set>
+#include <vector>
+
+#include "colmap_ext/image_io.h"
+#include "colmap_ext/runner.h"
+#include "colmap_ext/sparse_io.h"
+#include "colmap_ext/workspace.h"
+#include "fvs/controllers/prepare_stages.h"
+#include "fvs/controllers/sfm_steps.h"
+#include "fvs/controllers/stage_runner.h"
+#include "fvs/controllers/workspace_stages.h"
+#include "fvs/util/atomic_file.h"
+#include "fvs/util/error.h"
+#include "fvs/util/string_util.h"
+
+namespace fvs {
+namespace fs = std::filesystem;
+namespace {
+
+const char* kWho = "colmap view_synthesis_prepare";
+
+// One run of the stages on resolved options: absolute paths, the holdout names, the
+// photos, and the matcher and backends the installed COLMAP decides.
+class WorkspacePreparation {
+ public:
+  explicit WorkspacePreparation(const PrepareWorkspaceOptions& options)
+      : c_(Absolute(options)),
+        holdout_(ParseHoldoutList(options.holdout_images)),
+        ws_(c_.workspace_path) {}
+
+  void Run() {
+    CheckPhotos();
+    colmap::CreateDirectories(fvs_dir_);
+    RemoveAll(tmp_dir_);  // leftovers of a killed run: never trusted
+    colmap::CreateDirectories(tmp_dir_);
+    ChooseBackends(colmap::ProbeColmap());
+    StageRunner stages(Manifest::Load(ws_.ManifestPath(), c_.workspace_path), 8);
+    RunSfmStages(&stages);
+    RunDenseStages(&stages);
+    RemoveAll(tmp_dir_);
+    ReportRegistration(registration_path_, holdout_);
+    std::cerr << "Scene ready: " << c_.workspace_path << "\n";
+  }
+
+ private:
+  static PrepareWorkspaceOptions Absolute(PrepareWorkspaceOptions o) {
+    o.image_path = fs::absolute(o.image_path).lexically_normal().string();
+    o.workspace_path = fs::absolute(o.workspace_path).lexically_normal().string();
+    return o;
+  }
+
+  void CheckPhotos() {
+    images_ = ListImageFiles(c_.image_path);
+    for (const std::string& name : holdout_) {
+      if (!std::binary_search(images_.begin(), images_.end(), name)) {
+        throw Error(c_.image_path, "holdout image '" + name + "' is not in this folder");
+      }
+    }
+    if (images_.size() < 3) {
+      throw Error(c_.image_path, "only " + std::to_string(images_.size()) +
+                                     " images: view synthesis needs at least 3 photos");
+    }
+    // COLMAP skips a photo it cannot read and aborts later (an empty file made its
+    // matcher fail a CHECK): every photo's header is read here, before the workspace is
+    // touched.
+    for (const std::string& name : images_) {
+      int width = 0, height = 0;
+      colmap::ReadImageSize(JoinPaths(c_.image_path, name), &width, &height);
+    }
+  }
+
+  void ChooseBackends(const colmap::ColmapCapabilities& caps) {
+    matcher_ = c_.matcher;
+    matcher_reason_ = "--Matching.type " + matcher_;
+    if (matcher_ == "auto") {
+      const MatcherChoice choice = ChooseMatcher(images_, caps.has_cuda);
+      matcher_ = choice.type;
+      matcher_reason_ = choice.reason;
+    }
+    builtin_stereo_ =
+        c_.stereo_backend == "builtin" || (c_.stereo_backend == "auto" && !caps.has_cuda);
+    builtin_mesher_ =
+        c_.mesher_backend == "builtin" || (c_.mesher_backend == "auto" && !caps.has_cgal);
+    if (c_.stereo_backend == "colmap" && !caps.has_cuda) {
+      throw Error(kWho, "--Stereo.backend colmap needs a COLMAP built with CUDA; " +
+                            caps.executable + " has none (use builtin or auto)");
+    }
+    if (c_.mesher_backend == "colmap" && !caps.has_cgal) {
+      throw Error(kWho, "--Mesher.backend colmap needs a COLMAP built with CGAL; " +
+                            caps.executable + " has none (use builtin or auto)");
+    }
+    gpu_ = caps.has_cuda ? "1" : "0";
+  }
+
+  void RunSfmStages(StageRunner* stages);
+  void RunDenseStages(StageRunner* stages);
+  void ExtractFeatures();
+  void MatchIntoDatabase(const std::string& type);
+  void Map();
+  void Undistort();
+  void Stereo();
+  void Fuse();
+  void Mesh();
+
+  const PrepareWorkspaceOptions c_;
+  const std::set<std::string> holdout_;
+  const colmap::DenseWorkspace ws_;
+  const std::string fvs_dir_ = ws_.FvsDir();
+  const std::string tmp_dir_ = fvs_dir_ + "/tmp";
+  const std::string threads_ = std::to_string(c_.num_threads);
+  const std::string database_ = c_.workspace_path + "/database.db";
+  const std::string sfm_model_ = c_.workspace_path + "/sfm/0";
+  const std::string registration_path_ = fvs_dir_ + "/registration.json";
+  std::vector<std::string> images_;
+  std::string matcher_, matcher_reason_;
+  bool builtin_stereo_ = false, builtin_mesher_ = false;
+  std::string gpu_ = "0";
+};
+
+void WorkspacePreparation::RunSfmStages(StageRunner* stages) {
+  stages->Run("feature_extraction", {c_.image_path},
+              c_.camera_model + " single=" + std::to_string(c_.single_camera) +
+                  " size=" + std::to_string(c_.max_image_size),
+              {database_}, [&] { ExtractFeatures(); });
+  stages->Run("matching", {}, matcher_, {database_}, [&] {
+    std::cerr << "  " << matcher_ << " matching: " << matcher_reason_ << "\n";
+    MatchIntoDatabase(matcher_);
+  });
+  stages->Run("mapping", {}, "", {sfm_model_}, [&] { Map(); });
+  // Workspaces prepared before the report existed.
+  if (!fs::exists(registration_path_)) {
+    WriteRegistrationReport(registration_path_, images_, sfm_model_, matcher_, false);
+  }
+}
+
+void WorkspacePreparation::RunDenseStages(StageRunner* stages) {
+  std::string holdout_list;
+  for (const std::string& h : holdout_) holdout_list += h + ",";
+  stages->Run("undistortion", {},
+              "size=" + std::to_string(c_.max_image_size) + " holdout=" + holdout_list,
+              {ws_.ImagesDir(), ws_.SparseDir()}, [&] { Undistort(); });
+  stages->Run("stereo", {},
+              std::string(builtin_stereo_ ? "builtin" : "colmap") +
+                  " size=" + std::to_string(c_.stereo_max_image_size),
+              {ws_.StereoDir() + "/depth_maps"}, [&] { Stereo(); });
+  stages->Run("fusion", {}, "", {ws_.FusedPath(), ws_.FusedVisPath()}, [&] { Fuse(); });
+  stages->Run("meshing", {}, builtin_mesher_ ? "builtin" : "colmap",
+              {ws_.DelaunayMeshPath()}, [&] { Mesh(); });
+  stages->Run("depth_cache", {}, "", {ws_.FvsDir() + "/depth"},
+              [&] { BuildDepthCache(c_.workspace_path, -1); });
+}
+
+void WorkspacePreparation::ExtractFeatures() {
+  // A database left by a killed extraction is incomplete: start over.
+  const std::string tmp_db = tmp_dir_ + "/database.db";
+  colmap::RunColmap({"feature_extractor", "--database_path", tmp_db, "--image_path",
+                     c_.image_path, "--ImageReader.camera_model", c_.camera_model,
+                     "--ImageReader.single_camera", c_.single_camera ? "1" : "0",
+                     "--SiftExtraction.use_gpu", gpu_, "--SiftExtraction.max_image_size",
+                     std::to_string(c_.max_image_size), "--SiftExtraction.num_threads",
+                     threads_});
+  MoveIntoPlace(tmp_db, database_);
+}
+
+// Matching writes into the database: work on a copy, so a kill leaves what was there
+// untouched.
+void WorkspacePreparation::MatchIntoDatabase(const std::string& type) {
+  const std::string tmp_db = tmp_dir_ + "/database.db";
+  fs::copy_file(database_, tmp_db, fs::copy_options::overwrite_existing);
+  RunMatcher(type, tmp_db, images_, tmp_dir_ + "/pairs.txt", gpu_, threads_);
+  MoveIntoPlace(tmp_db, database_);
+}
+
+void WorkspacePreparation::Map() {
+  const int total = static_cast<int>(images_.size());
+  MappedModel best =
+      MapLargestModel(c_.image_path, database_, tmp_dir_ + "/sfm", threads_);
+  const bool retry = ShouldRetryExhaustive(matcher_, best.registered, total);
+  if (retry) {
+    std::cerr << "  registered " << best.registered << " of " << total << " images after "
+              << matcher_ << " matching: matching every pair and mapping again\n";
+    MatchIntoDatabase("exhaustive");
+    const MappedModel second =
+        MapLargestModel(c_.image_path, database_, tmp_dir_ + "/sfm_exhaustive", threads_);
+    if (second.registered > best.registered) best = second;
+  }
+  if (best.path.empty() || best.registered < 3) {
+    throw Error(c_.image_path, "SfM registered " + std::to_string(best.registered) +
+                                   " of " + std::to_string(total) +
+                                   " images: too few for view synthesis (photos need "
+                                   "more overlap and texture)");
+  }
+  std::cerr << "  registered " << best.registered << " of " << total << " images\n";
+  WriteRegistrationReport(registration_path_, images_, best.path, matcher_, retry);
+  colmap::CreateDirectories(c_.workspace_path + "/sfm");
+  MoveIntoPlace(best.path, sfm_model_);
+}
+
+void WorkspacePreparation::Undistort() {
+  const std::string out = tmp_dir_ + "/undistorted";
+  colmap::CreateDirectories(out);
+  colmap::RunColmap({"image_undistorter", "--image_path", c_.image_path, "--input_path",
+                     sfm_model_, "--output_path", out, "--output_type", "COLMAP",
+                     "--max_image_size", std::to_string(c_.max_image_size)});
+  const colmap::Reconstruction rec = colmap::ReadSparseModel(out + "/sparse");
+  for (const std::string& w : ShrunkenUndistortionWarnings(
+           colmap::ReadSparseModel(sfm_model_), rec, c_.max_image_size)) {
+    std::cerr << "WARNING: " << w << "\n";
+  }
+  colmap::CreateDirectories(ws_.StereoDir());
+  MoveIntoPlace(out + "/images", ws_.ImagesDir());
+  MoveIntoPlace(out + "/sparse", ws_.SparseDir());
+  WriteStereoConfigs(c_.workspace_path, holdout_);
+  WriteFileAtomic(fvs_dir_ + "/holdout.txt", [&](std::ostream& o) {
+    for (const std::string& h : holdout_) o << h << "\n";
+  });
+}
+
+void WorkspacePreparation::Stereo() {
+  if (builtin_stereo_) {
+    // view_synthesis_stereo's defaults, at the size asked for.
+    mvs::PatchMatchStereoOptions stereo;
+    if (c_.stereo_max_image_size > 0) stereo.max_image_size = c_.stereo_max_image_size;
+    RunBuiltinStereo(c_.workspace_path, stereo);
+    return;
+  }
+  colmap::RunColmap(
+      {"patch_match_stereo", "--workspace_path", c_.workspace_path, "--workspace_format",
+       "COLMAP", "--PatchMatchStereo.geom_consistency", "1",
+       "--PatchMatchStereo.max_image_size",
+       std::to_string(c_.stereo_max_image_size > 0 ? c_.stereo_max_image_size : -1)});
+}
+
+void WorkspacePreparation::Fuse() {
+  const std::string out = tmp_dir_ + "/fused.ply";
+  colmap::RunColmap({"stereo_fusion", "--workspace_path", c_.workspace_path,
+                     "--workspace_format", "COLMAP", "--input_type", "geometric",
+                     "--output_path", out, "--StereoFusion.num_threads", threads_});
+  std::error_code ec;
+  if (!fs::exists(out, ec) || fs::file_size(out, ec) < 300) {
+    throw Error(ws_.FusedPath(),
+                "stereo fusion produced no points (the depth maps are "
+                "empty: too little texture or overlap?)");
+  }
+  MoveIntoPlace(out + ".vis", ws_.FusedVisPath());
+  MoveIntoPlace(out, ws_.FusedPath());
+}
+
+void WorkspacePreparation::Mesh() {
+  if (builtin_mesher_) {
+    // view_synthesis_mesher's defaults and output.
+    RunBuiltinMesher(c_.workspace_path, ws_.DelaunayMeshPath(),
+                     mvs::DelaunayMeshingOptions());
+    return;
+  }
+  const std::string out = tmp_dir_ + "/meshed-delaunay.ply";
+  colmap::RunColmap({"delaunay_mesher", "--input_path", c_.workspace_path, "--input_type",
+                     "dense", "--output_path", out});
+  MoveIntoPlace(out, ws_.DelaunayMeshPath());
+}
+
+}  // namespace
+
+void PrepareWorkspaceOptions::Check() const {
+  const std::string who = kWho;
+  Require(
+      matcher == "auto" || matcher == "exhaustive" || matcher == "sequential", who,
+      "--Matching.type must be auto, exhaustive or sequential, not '" + matcher + "'");
+  Require(stereo_backend == "auto" || stereo_backend == "colmap" ||
+              stereo_backend == "builtin",
+          who, "--Stereo.backend must be auto, colmap or builtin");
+  Require(mesher_backend == "auto" || mesher_backend == "colmap" ||
+              mesher_backend == "builtin",
+          who, "--Mesher.backend must be auto, colmap or builtin");
+  Require(max_image_size > 0, who, "--max_image_size must be positive");
+  Require(stereo_max_image_size >= 0, who, "--Stereo.max_image_size must be >= 0");
+}
+
+void PrepareWorkspace(const PrepareWorkspaceOptions& options) {
+  options.Check();
+  WorkspacePreparation(options).Run();
+}
+
+}  // namespace fvs

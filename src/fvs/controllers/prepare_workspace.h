@@ -1,0 +1,41 @@
+// Preparing a workspace as one call: what `colmap view_synthesis_prepare` runs. Photos ->
+// ready scene: feature extraction, matching, mapping, undistortion (COLMAP), dense stereo
+// (COLMAP's when it has CUDA, else ours), fusion (COLMAP), meshing (COLMAP's when it has
+// CGAL, else ours), source depth cache. Each stage records a fingerprint of its inputs
+// and options in W/fvs/manifest.json and is skipped when that is unchanged and its
+// outputs exist. Fingerprints chain (a stage's includes the one before it), so changing
+// an early stage re-runs everything after it. Stages write into W/fvs/tmp/ and rename
+// into place, so kill -9 at any point loses at most the stage that was running
+// (stage_runner.h).
+#pragma once
+
+#include <string>
+
+namespace fvs {
+
+struct PrepareWorkspaceOptions {
+  std::string image_path;        // folder of the input photos
+  std::string workspace_path;    // the dense workspace made (relative paths are fine)
+  std::string matcher = "auto";  // auto | exhaustive | sequential (prepare_stages.h)
+  std::string camera_model = "SIMPLE_RADIAL";
+  bool single_camera = true;
+  int max_image_size = 1600;            // SIFT and undistortion
+  std::string stereo_backend = "auto";  // auto | colmap | builtin
+  std::string mesher_backend = "auto";  // auto | colmap | builtin
+  int stereo_max_image_size = 0;        // 0 = full undistorted size
+  // Registered by SfM but kept out of stereo, fusion and meshing: a file with one image
+  // name per line, or a comma-separated list.
+  std::string holdout_images;
+  int num_threads = -1;
+
+  // Throws fvs::Error with one line naming the option that is wrong.
+  void Check() const;
+};
+
+// Runs the stages that are not up to date, logging each on stderr, and ends with what SfM
+// registered. Checks the photos (at least 3, every one readable, every holdout among
+// them) and the backends asked for before the workspace is touched. Throws fvs::Error
+// with one line for bad input or a failed stage.
+void PrepareWorkspace(const PrepareWorkspaceOptions& options);
+
+}  // namespace fvs
