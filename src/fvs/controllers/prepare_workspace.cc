@@ -84,8 +84,10 @@ class WorkspacePreparation {
     }
     builtin_stereo_ =
         c_.stereo_backend == "builtin" || (c_.stereo_backend == "auto" && !caps.has_cuda);
-    builtin_mesher_ =
-        c_.mesher_backend == "builtin" || (c_.mesher_backend == "auto" && !caps.has_cgal);
+    // auto: ours even where COLMAP has CGAL. It is COLMAP's algorithm plus the SfM
+    // points and the stray-point filters, which cover more of the photos and render
+    // better on held-out views (doc/real_scenes.md); `colmap` still picks COLMAP's.
+    builtin_mesher_ = c_.mesher_backend != "colmap";
     if (c_.stereo_backend == "colmap" && !caps.has_cuda) {
       throw Error(kWho, "--Stereo.backend colmap needs a COLMAP built with CUDA; " +
                             caps.executable + " has none (use builtin or auto)");

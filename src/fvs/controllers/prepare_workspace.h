@@ -21,7 +21,7 @@ struct PrepareWorkspaceOptions {
   bool single_camera = true;
   int max_image_size = 1600;            // SIFT and undistortion
   std::string stereo_backend = "auto";  // auto | colmap | builtin
-  std::string mesher_backend = "auto";  // auto | colmap | builtin
+  std::string mesher_backend = "auto";  // auto (= builtin) | colmap | builtin
   int stereo_max_image_size = 0;        // 0 = full undistorted size
   // Registered by SfM but kept out of stereo, fusion and meshing: a file with one image
   // name per line, or a comma-separated list.

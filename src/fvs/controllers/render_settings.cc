@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colmap_ext/workspace.h"
+#include "fvs/render/method.h"
 #include "fvs/util/hash.h"
 
 namespace fvs {
@@ -86,7 +87,7 @@ std::string RenderSettingsJson(const RenderTargetsOptions& o) {
   json["temporal_blend"] = o.temporal.temporal_blend;
   json["fill_holes"] = o.render.fill_holes;
   // Tiles change the network's context at their seams.
-  if (o.method != "ulr" && o.method != "nearest") {
+  if (TraitsOfMethod(o.method).needs_weights) {
     json["precision"] = o.render.precision;
     json["tile_size"] = o.render.tile_size;
     json["tile_overlap"] = o.render.tile_overlap;

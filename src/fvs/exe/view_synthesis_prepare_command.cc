@@ -35,7 +35,7 @@ int RunPrepare(int argc, char** argv) {
   options.AddDefault("Stereo.max_image_size", &o.stereo_max_image_size,
                      "longest side for stereo (0 = undistorted size)");
   options.AddDefault("Mesher.backend", &o.mesher_backend,
-                     "auto (COLMAP when it has CGAL), colmap, builtin");
+                     "auto (builtin: COLMAP's algorithm with SfM points), colmap, builtin");
   options.AddDefault(
       "holdout_images", &o.holdout_images,
       "images registered by SfM but kept out of stereo, fusion and meshing: "
