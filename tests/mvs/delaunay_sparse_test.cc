@@ -17,6 +17,7 @@
 #include "colmap_ext/sparse_io.h"
 #include "fvs/geometry/ply.h"
 #include "fvs/mvs/delaunay_scene.h"
+#include "support/pinhole_model.h"
 #include "support/test_support.h"
 
 namespace fvs::mvs {
@@ -42,22 +43,9 @@ void WriteWorkspace(const std::string& dir, const DelaunayMeshingInput& fused,
   colmap::Reconstruction reconstruction;
   std::ofstream fusion_cfg(dir + "/stereo/fusion.cfg");
   for (size_t k = 0; k < fused.cameras.size(); ++k) {
-    const PinholeCamera& c = fused.cameras[k];
-    colmap::Camera camera;
-    camera.camera_id = static_cast<uint32_t>(k + 1);
-    camera.model_id = 1;  // PINHOLE
-    camera.width = c.width;
-    camera.height = c.height;
-    camera.params = {c.fx, c.fy, c.cx, c.cy};
-    reconstruction.cameras[camera.camera_id] = camera;
-    colmap::Image image;
-    image.image_id = camera.camera_id;
-    image.camera_id = camera.camera_id;
-    image.qvec = RotationToQuaternion(c.R);
-    image.tvec = c.t;
-    image.name = "image" + std::to_string(k) + ".png";
-    reconstruction.images[image.image_id] = image;
-    if (!held_out.count(k)) fusion_cfg << image.name << "\n";
+    const std::string name = "image" + std::to_string(k) + ".png";
+    testing::AddPinholeImage(fused.cameras[k], name, &reconstruction);
+    if (!held_out.count(k)) fusion_cfg << name << "\n";
   }
   for (size_t i = 0; i < sfm.size(); ++i) {
     colmap::Point3D point;

@@ -19,6 +19,7 @@
 #include "fvs/mvs/delaunay_scene.h"
 #include "fvs/mvs/isolated_points.h"
 #include "fvs/util/error.h"
+#include "support/pinhole_model.h"
 #include "support/test_support.h"
 
 namespace fvs::mvs {
@@ -298,21 +299,8 @@ void WriteWorkspace(const std::string& dir, const DelaunayMeshingInput& input) {
   colmap::WriteFusedVisibility(dir + "/fused.ply.vis", input.visibility);
   colmap::Reconstruction reconstruction;
   for (size_t k = 0; k < input.cameras.size(); ++k) {
-    const PinholeCamera& c = input.cameras[k];
-    colmap::Camera camera;
-    camera.camera_id = static_cast<uint32_t>(k + 1);
-    camera.model_id = 1;  // PINHOLE
-    camera.width = c.width;
-    camera.height = c.height;
-    camera.params = {c.fx, c.fy, c.cx, c.cy};
-    reconstruction.cameras[camera.camera_id] = camera;
-    colmap::Image image;
-    image.image_id = static_cast<uint32_t>(k + 1);
-    image.camera_id = camera.camera_id;
-    image.qvec = RotationToQuaternion(c.R);
-    image.tvec = c.t;
-    image.name = "image" + std::to_string(k) + ".png";
-    reconstruction.images[image.image_id] = image;
+    testing::AddPinholeImage(input.cameras[k], "image" + std::to_string(k) + ".png",
+                             &reconstruction);
   }
   colmap::WriteSparseModelBinary(dir + "/sparse", reconstruction);
 }

@@ -21,6 +21,7 @@
 #include "fvs/geometry/quad_grid.h"
 #include "fvs/geometry/rasterizer.h"
 #include "fvs/scene/scene.h"
+#include "support/pinhole_model.h"
 
 namespace fvs::testing {
 
@@ -169,20 +170,7 @@ inline void WriteTestWorkspace(const std::string& root,
   colmap::Reconstruction rec;
   for (size_t i = 0; i < views.size(); ++i) {
     const PinholeCamera& c = views[i].camera;
-    colmap::Camera camera;
-    camera.camera_id = static_cast<uint32_t>(i + 1);
-    camera.model_id = 1;  // PINHOLE
-    camera.width = c.width;
-    camera.height = c.height;
-    camera.params = {c.fx, c.fy, c.cx, c.cy};
-    rec.cameras[camera.camera_id] = camera;
-    colmap::Image image;
-    image.image_id = static_cast<uint32_t>(i + 1);
-    image.camera_id = camera.camera_id;
-    image.name = views[i].name;
-    image.qvec = RotationToQuaternion(c.R);
-    image.tvec = c.t;
-    rec.images[image.image_id] = image;
+    AddPinholeImage(c, views[i].name, &rec);
     colmap::WriteImage(root + "/images/" + views[i].name, RenderGroundTruth(mesh, c));
   }
   colmap::WriteSparseModelText(root + "/sparse", rec);
