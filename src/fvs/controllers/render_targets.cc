@@ -18,6 +18,7 @@
 #include "fvs/util/machine.h"
 #include "fvs/util/progress.h"
 #include "fvs/util/shard.h"
+#include "fvs/util/stale_temp_files.h"
 #include "fvs/util/string_util.h"
 
 namespace fvs {
@@ -88,6 +89,8 @@ void CheckSourcePhotos(const Scene& scene) {
 // the same settings. Records this run's settings before the first frame, so that a
 // killed run has them too.
 bool ResumeAllowed(const RenderTargetsOptions& o, const std::string& settings) {
+  // A killed run's half-written files go first: they are never frames.
+  RemoveStaleTempFiles(o.output_path);
   const std::string settings_path = JoinPaths(o.output_path, "render_settings.json");
   bool resume = !o.overwrite;
   if (resume) {
