@@ -56,6 +56,9 @@ std::map<std::string, std::string> FilesUnder(const std::string& dir,
 
 void ExpectSameFiles(const std::map<std::string, std::string>& expected,
                      const std::map<std::string, std::string>& actual) {
+  for (const auto& [name, bytes] : actual) {
+    EXPECT_TRUE(expected.count(name)) << name << " is left over";
+  }
   ASSERT_EQ(expected.size(), actual.size());
   for (const auto& [name, bytes] : expected) {
     ASSERT_TRUE(actual.count(name)) << name << " is missing";

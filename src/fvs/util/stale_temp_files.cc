@@ -13,7 +13,8 @@ int RemoveStaleTempFiles(const std::string& dir) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return 0;
-  static const std::regex kTemp(R"(.+\.tmp-([0-9]+)-[0-9]+)");
+  // Images keep their extension after the counter (OIIO picks the format from it).
+  static const std::regex kTemp(R"(.+\.tmp-([0-9]+)-[0-9]+(\.[A-Za-z0-9]+)?)");
   int removed = 0;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     std::smatch match;
