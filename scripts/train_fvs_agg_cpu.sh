@@ -9,8 +9,9 @@
 # view_synthesis_eval --protocol holdout; their packs are what the trainer validates on
 # (it skips the held-out views, which are kept for the reported evaluation).
 # FVS_TRAIN_STEPS (default 200000), FVS_RUN (the run folder under runs/, default fvs_agg),
-# FVS_INIT (weights a new run starts from; a run with checkpoints resumes from them) and
-# FVS_PREPARE_ONLY=1 steer it.
+# FVS_INIT (weights a new run starts from; a run with checkpoints resumes from them),
+# FVS_PACK_SCALE (0.5; the real scenes' pack size, 1 = the size view_synthesis_eval renders
+# them at; other scales pack into packed_s<scale>/) and FVS_PREPARE_ONLY=1 steer it.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 DATASETS="$(realpath "${1:-../shared/datasets}")"
@@ -23,7 +24,10 @@ LPIPS="${FVS_LPIPS_PATH:-$(realpath -m ../shared/weights/lpips_alex.safetensors)
 # L1 + (1 - SSIM) + LPIPS: LPIPS alone traded SSIM for texture (doc/training.md).
 LOSS="${FVS_LOSS:-$([[ -n "$LPIPS" ]] && echo l1+ssim+lpips || echo l1+ssim)}"
 [[ -x "$COLMAP" ]] || scripts/build.sh
-mkdir -p "$WORK"/{bin,images,ws,packed,runs}
+SCALE="${FVS_PACK_SCALE:-0.5}"
+PACKED=packed
+[[ "$SCALE" == "0.5" ]] || PACKED="packed_s$SCALE"
+mkdir -p "$WORK"/{bin,images,ws,packed,runs} "$WORK/$PACKED"
 # A copy, so that rebuilding build/ never changes the binary under a running stage.
 # (Copied then renamed: a binary still running from an earlier run is "text file busy".)
 cp "$COLMAP" "$WORK/bin/colmap.tmp" && mv -f "$WORK/bin/colmap.tmp" "$WORK/bin/colmap"
@@ -56,9 +60,9 @@ prepare_scene() {
 
 pack_scene() {
   local scene=$1
-  [[ -f ws/$scene/.done && ! -f packed/$scene/scene.safetensors ]] || return 0
+  [[ -f ws/$scene/.done && ! -f $PACKED/$scene/scene.safetensors ]] || return 0
   FVS_QUIET=1 nice -n "$NICE" bin/colmap view_synthesis_pack --workspace_path ws/$scene \
-    --output_path packed/$scene --scale 0.5 > /dev/null
+    --output_path $PACKED/$scene --scale "$SCALE" > /dev/null
 }
 
 for seed in 11 12 13 14; do
@@ -70,6 +74,12 @@ for seed in 11 12 13 14; do
   FVS_QUIET=1 nice -n "$NICE" bin/colmap view_synthesis_pack --workspace_path ws/synthetic_$seed \
     --output_path packed/synthetic_$seed --scale 1 > /dev/null
 done
+# The generated scenes are packed at their own size whatever the scale of the real ones.
+if [[ "$PACKED" != packed ]]; then
+  for seed in 11 12 13 14; do
+    ln -sfn "$PWD/packed/synthetic_$seed" "$PACKED/synthetic_$seed"
+  done
+fi
 
 # Validation first (small), then training scenes, smallest first.
 # middlebury_dino (a black backdrop like the temple's) and wall_clock fail in the mapper
@@ -83,15 +93,17 @@ for spec in middlebury_temple:1:1 monstree:1:1 fox:2:1 sceaux_castle:1:0 \
 done
 [[ "${FVS_PREPARE_ONLY:-0}" == "1" ]] && exit 0
 
-printf "packed/middlebury_temple\npacked/fox\npacked/monstree\n" > val.txt
-ls -d packed/*/ | sed 's#/$##' | grep -v -e middlebury_temple -e /fox -e /monstree > train.txt
+LISTS="${PACKED#packed}"  # val.txt, train.txt; val_s1.txt, train_s1.txt at scale 1
+printf "$PACKED/middlebury_temple\n$PACKED/fox\n$PACKED/monstree\n" > val$LISTS.txt
+ls -d $PACKED/*/ | sed 's#/$##' | grep -v -e middlebury_temple -e /fox -e /monstree \
+  > train$LISTS.txt
 
 # Passive OpenMP waits: with anything else running, spinning threads that wait for a core
 # made steps several times slower on this 2-core machine.
 exec nice -n "$NICE" env FVS_NUM_THREADS="${FVS_NUM_THREADS:-$(nproc)}" \
   OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-PASSIVE}" FVS_LPIPS_PATH="$LPIPS" \
   bin/colmap view_synthesis_train \
-  --scene_list train.txt --val_scene_list val.txt --output_path "runs/${FVS_RUN:-fvs_agg}" \
+  --scene_list train$LISTS.txt --val_scene_list val$LISTS.txt --output_path "runs/${FVS_RUN:-fvs_agg}" \
   ${FVS_INIT:+--Train.init_weights "$FVS_INIT"} \
   --Train.variant fvs_agg --Train.crop 128 --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
   --Train.batch_size 4 --Train.learning_rate "${FVS_LR:-2e-4}" --Train.val_every 250 \

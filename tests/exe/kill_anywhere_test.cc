@@ -1,9 +1,10 @@
 // Kill -9 anywhere (issue 18 item 4), through the front door: a render of a frame
-// sequence and a training run are killed with SIGKILL at several points (after a few
+// sequence, an evaluation and a training run are killed with SIGKILL at several points (after a few
 // frames or checkpoints, and again part-way through the rerun), then run to the end. The
 // final outputs must equal those of an uninterrupted run byte for byte (both are
-// deterministic: the ulr renderer, and one-thread training from a seed), and the frames
-// or steps finished before a kill are not done again. (view_synthesis_prepare's kill
+// deterministic: the ulr renderer, and one-thread training from a seed; an evaluation's
+// seconds per view are not, so its rows are compared without them), and the frames,
+// views or steps finished before a kill are not done again. (view_synthesis_prepare's kill
 // test is tests/exe/prepare_end_to_end_test.cc.)
 #include <gtest/gtest.h>
 
@@ -12,6 +13,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -94,6 +96,72 @@ TEST(KillAnywhere, KilledVideoRenderEndsWithTheUninterruptedFrames) {
       nlohmann::json::parse(ReadTextFile(dir / "killed/frame_report.json"));
   EXPECT_GE(report["num_resumed"].get<int>(), 9) << log;
   EXPECT_LE(report["num_rendered"].get<int>(), 7) << log;
+}
+
+// results.csv without its run-time columns (seconds, cpu_seconds): the rest of a row is
+// deterministic. (No field of these rows holds a comma.)
+std::string ResultsWithoutTimes(const std::string& path) {
+  std::string text = ReadTextFile(path), out;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::stringstream line(text.substr(start, end - start));
+    std::string field;
+    for (int i = 0; std::getline(line, field, ','); ++i) {
+      if (i != 14 && i != 15) out += field + ",";
+    }
+    out += "\n";
+    start = end + 1;
+  }
+  return out;
+}
+
+TEST(KillAnywhere, KilledEvaluationEndsWithTheUninterruptedResults) {
+  TempDir dir;
+  WriteTestWorkspace(dir / "ws", ArcViews(12, 240, 180), MakeTestWorldMesh());
+  auto evaluate = [&](const std::string& out) {
+    return FrontDoor() + " view_synthesis_eval --workspace_path " + dir / "ws" +
+           " --protocol leave_one_out --method ulr --num_sources 3 --num_threads 1"
+           " --output_path " + out;
+  };
+  std::string log;
+  ASSERT_EQ(RunShell("FVS_LPIPS_PATH= " + evaluate(dir / "straight") + " 2>&1", &log), 0)
+      << log;
+  ASSERT_TRUE(ResultsWithoutTimes(dir / "straight/results.csv").find("view_011.png") !=
+              std::string::npos);
+
+  // Killed after the 3rd view, the rerun killed after the 8th, then run to the end.
+  const std::string killed = "FVS_LPIPS_PATH= " + evaluate(dir / "killed");
+  const std::string journal = dir / "killed/views/ulr_k3_s1/";
+  ASSERT_TRUE(KillWhenExists(killed, journal + "view_002.png.json")) << "ended too soon";
+  ASSERT_TRUE(KillWhenExists(killed, journal + "view_007.png.json")) << "ended too soon";
+  ASSERT_EQ(RunShell(killed + " 2>&1", &log), 0) << log;
+  EXPECT_EQ(ResultsWithoutTimes(dir / "straight/results.csv"),
+            ResultsWithoutTimes(dir / "killed/results.csv"));
+  // The last run evaluated only what the kills had left undone.
+  std::smatch resumed;
+  ASSERT_TRUE(std::regex_search(log, resumed, std::regex("resuming: ([0-9]+) of 12")))
+      << log;
+  EXPECT_GE(std::stoi(resumed[1]), 8) << log;
+  // Run once more, every view comes from the journal, seconds and thumbnails included:
+  // the reports are those of the run before, byte for byte (the contact sheet's
+  // captions hold the seconds, so the straight run's sheet differs).
+  const auto reports = FilesUnder(dir / "killed", {"machine.txt"});
+  ASSERT_EQ(RunShell(killed + " 2>&1", &log), 0) << log;
+  EXPECT_NE(log.find("resuming: 12 of 12"), std::string::npos) << log;
+  ExpectSameFiles(reports, FilesUnder(dir / "killed", {"machine.txt"}));
+
+  // Other settings (here K) evaluate every view again; so does --overwrite 1.
+  ASSERT_EQ(RunShell(FrontDoor() + " view_synthesis_eval --workspace_path " + dir / "ws" +
+                         " --protocol leave_one_out --method ulr --num_sources 2"
+                         " --num_threads 1 --output_path " + dir / "killed" + " 2>&1",
+                     &log),
+            0)
+      << log;
+  EXPECT_EQ(log.find("resuming:"), std::string::npos) << log;
+  ASSERT_EQ(RunShell(killed + " --overwrite 1 2>&1", &log), 0) << log;
+  EXPECT_EQ(log.find("resuming:"), std::string::npos) << log;
 }
 
 TEST(KillAnywhere, KilledTrainingEndsWithTheUninterruptedWeights) {

@@ -2,11 +2,16 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include "fvs/controllers/evaluation_report.h"
+#include "fvs/controllers/render_settings.h"
 #include "fvs/eval/lpips.h"
+#include "fvs/eval/view_journal.h"
+#include "fvs/render/fvs_method.h"
 #include "fvs/scene/scene.h"
 #include "fvs/util/error.h"
+#include "fvs/util/hash.h"
 #include "fvs/util/machine.h"
 #include "fvs/util/shard.h"
 
@@ -110,6 +115,41 @@ size_t SheetConfig(const EvaluationOptions& o, const std::vector<EvalConfig>& co
   return sheet;
 }
 
+// The hash of the file at `path`, or "" when there is none.
+std::string FileHashOrEmpty(const std::string& path) {
+  std::error_code ec;
+  if (path.empty() || !std::filesystem::is_regular_file(path, ec)) return "";
+  return HexHash(HashFile(path));
+}
+
+// What decides a view's result, for the journal of finished views
+// (eval/view_journal.h): change any of it and every view is evaluated again. Threads
+// and the shard do not change a view's result.
+std::string JournalSettings(const EvaluationOptions& o,
+                            const std::vector<EvalConfig>& configs,
+                            const std::string& scene_model_dir) {
+  nlohmann::json json;
+  json["workspace_hash"] = WorkspaceContentHash(o.workspace_path);
+  json["scene_name"] = SceneName(o);
+  json["protocol"] = {o.protocol.protocol, o.protocol.every, o.protocol.subsequence,
+                      o.protocol.target_indices, o.protocol.target_names};
+  json["configurations"] = nlohmann::json::array();
+  for (const EvalConfig& c : configs) {
+    std::string weights = c.model_path;
+    if (weights.empty() && TraitsOfMethod(c.method).needs_weights) {
+      weights = DefaultModelPath(c.method, scene_model_dir);
+    }
+    json["configurations"].push_back({c.Label(), FileHashOrEmpty(weights)});
+  }
+  json["lpips_hash"] = FileHashOrEmpty(ResolveLpipsPath(o.lpips_path));
+  json["max_num_sources"] = o.max_num_sources;
+  json["fill_holes"] = o.fill_holes;
+  json["device"] = o.device;
+  json["thumbnail_width"] = o.thumbnail_width;
+  json["write_images"] = o.write_images;
+  return json.dump(2) + "\n";
+}
+
 }  // namespace
 
 void EvaluationOptions::Check() const {
@@ -158,6 +198,10 @@ EvaluationResult RunEvaluation(const EvaluationOptions& o) {
   result.scene_name = SceneName(o);
   run.scene_name = result.scene_name;
   if (o.write_images) run.write_images_dir = o.output_path + "/renders";
+  const eval::ViewJournal journal(o.output_path + "/views",
+                                  JournalSettings(o, configs, run.render.scene_model_dir),
+                                  o.overwrite);
+  run.journal = &journal;
 
   const size_t sheet_config = SheetConfig(o, configs);
   ContactSheetViews sheet;

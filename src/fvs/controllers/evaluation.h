@@ -4,7 +4,9 @@
 // or every configuration of a sweep (eval/sweep.h), scored against the photos (PSNR,
 // SSIM, LPIPS when its weights are found) beside their run time, and written to
 // <output_path>/results.csv, summary.csv, results.md, machine.txt, contact_sheet.png and,
-// for more than one configuration, error_vs_time.png.
+// for more than one configuration, error_vs_time.png. Each view's result is kept in
+// <output_path>/views/ as soon as it is done (eval/view_journal.h): a killed evaluation,
+// run again with the same settings, renders only the views it had not finished.
 //
 // Bad views are reported in their rows and the others still evaluated
 // (RequireNoFailedViews turns them into an error afterwards). A held-out image SfM did
@@ -36,6 +38,8 @@ struct EvaluationOptions {
   std::string scene_name;     // in the reports; empty: the workspace folder's name
   int thumbnail_width = 320;  // contact sheet tiles; 0: no contact sheet
   bool write_images = false;  // every render to <output_path>/renders/<configuration>/
+  bool overwrite =
+      false;  // evaluate every view again (else <output_path>/views/ resumes)
   int num_threads = 0;
   int max_num_sources = RenderOptions().max_num_sources;
   bool fill_holes = true;

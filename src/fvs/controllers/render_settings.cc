@@ -26,14 +26,6 @@ std::vector<std::string> FilesBelow(const std::string& folder) {
   return files;
 }
 
-// What the renderer takes from the workspace: the sparse model, the mesh and the
-// undistorted photos (the source depths follow from the first two).
-std::string WorkspaceHash(const std::string& workspace_path) {
-  const colmap::DenseWorkspace ws(workspace_path);
-  return ContentHash({ws.SparseDir(), ws.DelaunayMeshPath(), ws.ImagesDir()},
-                     workspace_path);
-}
-
 // The target file and, for images.txt, the cameras.txt beside it.
 std::string TargetsHash(const RenderTargetsOptions& o) {
   if (!o.camera_path.empty()) {
@@ -67,13 +59,19 @@ std::string ContentHash(const std::vector<std::string>& paths, const std::string
   return HexHash(hash);
 }
 
+std::string WorkspaceContentHash(const std::string& workspace_path) {
+  const colmap::DenseWorkspace ws(workspace_path);
+  return ContentHash({ws.SparseDir(), ws.DelaunayMeshPath(), ws.ImagesDir()},
+                     workspace_path);
+}
+
 std::string RenderSettingsJson(const RenderTargetsOptions& o) {
   nlohmann::json json;
   json["method"] = o.method;
   if (!o.render.model_path.empty()) {
     json["weights_hash"] = HexHash(HashFile(o.render.model_path));
   }
-  json["workspace_hash"] = WorkspaceHash(o.workspace_path);
+  json["workspace_hash"] = WorkspaceContentHash(o.workspace_path);
   json["num_sources"] = o.render.num_sources;
   if (o.render.num_sources == 0) json["max_num_sources"] = o.render.max_num_sources;
   json["selection_tolerance"] = o.render.selection_tolerance;

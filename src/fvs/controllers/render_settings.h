@@ -14,6 +14,10 @@ namespace fvs {
 // hash. A path that does not exist adds nothing.
 std::string ContentHash(const std::vector<std::string>& paths, const std::string& root);
 
+// Content hash of what the renderer takes from the workspace: the sparse model, the mesh
+// and the undistorted photos (the source depths follow from the first two).
+std::string WorkspaceContentHash(const std::string& workspace_path);
+
 // The settings of `options` (after RunRenderTargets completed them) with the hashes of
 // the weights, the workspace (sparse model, mesh, photos) and the target file, as
 // indented JSON ending in a newline: equal text, equal frames.

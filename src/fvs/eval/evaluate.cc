@@ -1,5 +1,6 @@
 #include "fvs/eval/evaluate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -8,6 +9,7 @@
 #include "colmap_ext/image_io.h"
 #include "fvs/eval/draw.h"
 #include "fvs/eval/metrics.h"
+#include "fvs/eval/view_journal.h"
 #include "fvs/render/targets.h"
 #include "fvs/scene/scene.h"
 #include "fvs/util/error.h"
@@ -100,6 +102,126 @@ void PreloadPhotos(const Scene& scene,
   }
 }
 
+namespace {
+
+// The sources no target may use: the withheld set and photos that cannot be read.
+std::vector<int> SharedExcludedSources(
+    const Scene& scene, const TargetSet& set,
+    const std::vector<std::pair<int, std::string>>& bad_photos) {
+  std::vector<int> excluded;
+  std::set<int> bad;
+  for (const auto& [index, error] : bad_photos) {
+    excluded.push_back(index);
+    bad.insert(index);
+  }
+  for (const std::string& name : set.excluded_sources) {
+    const int index = scene.FindView(name);
+    if (index >= 0 && !bad.count(index)) excluded.push_back(index);
+  }
+  return excluded;
+}
+
+// Renders the target of `r` (index `index` in the scene) and fills in its scores;
+// *thumbnail gets the render's thumbnail when thumbnails are asked for. Throws for a
+// view that cannot be evaluated.
+void EvaluateView(const Scene& scene, int index, const std::vector<int>& excluded,
+                  const EvalConfig& config, const EvalRunOptions& options, Method* method,
+                  ViewResult* r, Image* thumbnail) {
+  const Image& truth = scene.SourceImage(index);  // throws for a bad photo
+  r->width = truth.width;
+  r->height = truth.height;
+  TargetView view;
+  view.name = r->target;
+  view.camera = ResizeTarget(scene.view(index).camera, 0, 0, config.scale);
+  view.exclude_views = excluded;
+  view.exclude_views.push_back(index);
+
+  Timer timer;
+  const double cpu_start = ProcessCpuSeconds();
+  const RenderResult result = method->Render(scene, view);
+  Image prediction = result.color;
+  if (prediction.width != truth.width || prediction.height != truth.height) {
+    prediction = ResizeImage(prediction, truth.width, truth.height);
+  }
+  r->seconds = timer.Seconds();
+  r->cpu_seconds = ProcessCpuSeconds() - cpu_start;
+  prediction = QuantizeTo8Bit(prediction);
+
+  r->psnr = Psnr(prediction, truth);
+  r->ssim = Ssim(prediction, truth);
+  if (options.lpips) r->lpips = options.lpips(prediction, truth);
+  Image covered_mask = result.coverage;
+  if (covered_mask.width != truth.width || covered_mask.height != truth.height) {
+    covered_mask = ResizeImage(covered_mask, truth.width, truth.height);
+  }
+  try {
+    r->psnr_covered = Psnr(prediction, truth, &covered_mask);
+    r->ssim_covered = Ssim(prediction, truth, &covered_mask);
+  } catch (const Error&) {
+    // Nothing covered: the covered-only numbers do not exist.
+  }
+  r->sources_used = static_cast<int>(result.sources.size());
+  double covered = 0;
+  for (float c : result.coverage.data) covered += c;
+  r->coverage = covered / std::max<size_t>(1, result.coverage.data.size());
+  CountPixelOrigins(result, r);
+  Require(std::isfinite(r->psnr) && std::isfinite(r->ssim), r->target,
+          "metrics are not finite (NaN or Inf in the rendered image)");
+  if (!options.write_images_dir.empty()) {
+    colmap::WriteImage(options.write_images_dir + "/" + config.Slug() + "/" +
+                           FileStem(r->target) + ".png",
+                       prediction);
+  }
+  if (options.thumbnail_width > 0) {
+    *thumbnail = Thumbnail(prediction, options.thumbnail_width);
+  }
+}
+
+void MarkFailed(const std::string& error, ViewResult* r) {
+  r->error = error;
+  r->psnr = r->ssim = r->lpips = r->seconds = r->cpu_seconds = r->coverage =
+      kNotAvailable;
+  r->mesh_pixels = r->infinity_pixels = r->filled_pixels = kNotAvailable;
+  r->psnr_covered = r->ssim_covered = kNotAvailable;
+}
+
+// The rows of `targets` before rendering: what the protocol says of each, and the result
+// a journal kept of an earlier run (then `resumed`).
+struct PlannedView {
+  ViewResult row;
+  int index = -1;  // in the scene
+  bool resumed = false;
+  Image thumbnail;
+};
+
+std::vector<PlannedView> PlanViews(const Scene& scene, const TargetSet& set,
+                                   const std::vector<EvalTarget>& targets,
+                                   const EvalConfig& config,
+                                   const EvalRunOptions& options) {
+  std::vector<PlannedView> views;
+  for (const EvalTarget& target : targets) {
+    PlannedView v;
+    ViewResult& r = v.row;
+    r.scene = options.scene_name;
+    r.config = config;
+    r.protocol = set.protocol;
+    r.target = target.name;
+    r.geometry_holdout = target.geometry_holdout;
+    r.error = target.error;
+    r.skipped = target.skipped;
+    v.index = r.ok() ? scene.FindView(target.name) : -1;
+    if (r.ok() && v.index < 0) r.error = "not a registered image of the model";
+    if (r.ok() && options.journal) {
+      v.resumed = options.journal->Find(
+          config, target.name, &r, options.thumbnail_width > 0 ? &v.thumbnail : nullptr);
+    }
+    views.push_back(std::move(v));
+  }
+  return views;
+}
+
+}  // namespace
+
 std::vector<ViewResult> EvaluateTargets(
     const Scene& scene, const TargetSet& set, const std::vector<EvalTarget>& targets,
     const EvalConfig& config, const EvalRunOptions& options,
@@ -110,105 +232,49 @@ std::vector<ViewResult> EvaluateTargets(
   render.model_path = config.model_path;
   render.precision = config.precision;
   std::unique_ptr<Method> method = CreateMethod(config.method, render);
-
-  // Sources no target may use: the withheld set and photos that cannot be read.
-  std::vector<int> shared_exclude;
-  std::set<int> bad;
-  for (const auto& [index, error] : bad_photos) {
-    shared_exclude.push_back(index);
-    bad.insert(index);
-  }
-  for (const std::string& name : set.excluded_sources) {
-    const int index = scene.FindView(name);
-    if (index >= 0 && !bad.count(index)) shared_exclude.push_back(index);
-  }
+  const std::vector<int> excluded = SharedExcludedSources(scene, set, bad_photos);
   if (!options.write_images_dir.empty()) {
     std::filesystem::create_directories(options.write_images_dir + "/" + config.Slug());
   }
 
-  std::vector<ViewResult> results;
+  std::vector<PlannedView> views = PlanViews(scene, set, targets, config, options);
+  const int64_t num_resumed = std::count_if(
+      views.begin(), views.end(), [](const PlannedView& v) { return v.resumed; });
+  if (num_resumed > 0) {
+    std::printf(
+        "resuming: %lld of %zu views of %s already evaluated in %s (--overwrite 1 "
+        "evaluates them again)\n",
+        static_cast<long long>(num_resumed), views.size(), config.Label().c_str(),
+        options.journal->dir().c_str());
+  }
   std::unique_ptr<Progress> progress;
   if (options.show_progress) {
-    progress = std::make_unique<Progress>("evaluate " + config.Label(),
-                                          static_cast<int64_t>(targets.size()));
+    progress = std::make_unique<Progress>(
+        "evaluate " + config.Label(), static_cast<int64_t>(views.size()) - num_resumed);
   }
-  for (const EvalTarget& target : targets) {
-    ViewResult r;
-    r.scene = options.scene_name;
-    r.config = config;
-    r.protocol = set.protocol;
-    r.target = target.name;
-    r.geometry_holdout = target.geometry_holdout;
-    r.error = target.error;
-    r.skipped = target.skipped;
-    const int index = r.ok() ? scene.FindView(target.name) : -1;
-    if (r.ok() && index < 0) r.error = "not a registered image of the model";
-    if (r.ok()) {
+  std::vector<ViewResult> results;
+  for (PlannedView& v : views) {
+    ViewResult& r = v.row;
+    if (r.ok() && !v.resumed) {
       try {
-        const Image& truth = scene.SourceImage(index);  // throws for a bad photo
-        r.width = truth.width;
-        r.height = truth.height;
-        TargetView view;
-        view.name = target.name;
-        view.camera = ResizeTarget(scene.view(index).camera, 0, 0, config.scale);
-        view.exclude_views = shared_exclude;
-        view.exclude_views.push_back(index);
-
-        Timer timer;
-        const double cpu_start = ProcessCpuSeconds();
-        const RenderResult result = method->Render(scene, view);
-        Image prediction = result.color;
-        if (prediction.width != truth.width || prediction.height != truth.height) {
-          prediction = ResizeImage(prediction, truth.width, truth.height);
-        }
-        r.seconds = timer.Seconds();
-        r.cpu_seconds = ProcessCpuSeconds() - cpu_start;
-        prediction = QuantizeTo8Bit(prediction);
-
-        r.psnr = Psnr(prediction, truth);
-        r.ssim = Ssim(prediction, truth);
-        if (options.lpips) r.lpips = options.lpips(prediction, truth);
-        Image covered_mask = result.coverage;
-        if (covered_mask.width != truth.width || covered_mask.height != truth.height) {
-          covered_mask = ResizeImage(covered_mask, truth.width, truth.height);
-        }
-        try {
-          r.psnr_covered = Psnr(prediction, truth, &covered_mask);
-          r.ssim_covered = Ssim(prediction, truth, &covered_mask);
-        } catch (const Error&) {
-          // Nothing covered: the covered-only numbers do not exist.
-        }
-        r.sources_used = static_cast<int>(result.sources.size());
-        double covered = 0;
-        for (float c : result.coverage.data) covered += c;
-        r.coverage = covered / std::max<size_t>(1, result.coverage.data.size());
-        CountPixelOrigins(result, &r);
-        Require(std::isfinite(r.psnr) && std::isfinite(r.ssim), target.name,
-                "metrics are not finite (NaN or Inf in the rendered image)");
-        if (!options.write_images_dir.empty()) {
-          colmap::WriteImage(options.write_images_dir + "/" + config.Slug() + "/" +
-                                 FileStem(target.name) + ".png",
-                             prediction);
-        }
-        if (thumbnails && options.thumbnail_width > 0) {
-          thumbnails->push_back({target.name,
-                                 Thumbnail(prediction, options.thumbnail_width),
-                                 Thumbnail(truth, options.thumbnail_width)});
-        }
+        EvaluateView(scene, v.index, excluded, config, options, method.get(), &r,
+                     &v.thumbnail);
+        if (options.journal) options.journal->Record(r, v.thumbnail);
       } catch (const std::exception& e) {
-        r.error = e.what();
-        r.psnr = r.ssim = r.lpips = r.seconds = r.cpu_seconds = r.coverage =
-            kNotAvailable;
-        r.mesh_pixels = r.infinity_pixels = r.filled_pixels = kNotAvailable;
-        r.psnr_covered = r.ssim_covered = kNotAvailable;
+        MarkFailed(e.what(), &r);
       }
+    }
+    if (r.ok() && thumbnails && options.thumbnail_width > 0 && !v.thumbnail.empty()) {
+      thumbnails->push_back(
+          {r.target, v.thumbnail,
+           Thumbnail(scene.SourceImage(v.index), options.thumbnail_width)});
     }
     if (!r.ok()) {
       std::fprintf(stderr, "WARNING: %s [%s]: %s%s\n", r.target.c_str(),
                    config.Label().c_str(), r.skipped ? "skipped: " : "", r.error.c_str());
     }
+    if (progress && !v.resumed) progress->Advance();
     results.push_back(std::move(r));
-    if (progress) progress->Advance();
   }
   if (progress) progress->Finish();
   return results;

@@ -25,6 +25,8 @@ class Scene;
 
 namespace fvs::eval {
 
+class ViewJournal;
+
 // One point of an evaluation (or of a sweep): method, K, resolution scale, precision.
 struct EvalConfig {
   std::string method = "ulr";
@@ -99,6 +101,9 @@ struct EvalRunOptions {
   std::string write_images_dir;  // non-empty: write <dir>/<slug>/<target>.png
   std::string scene_name;        // the "scene" column
   bool show_progress = true;
+  // Not null: views it kept are not rendered again, and each view evaluated is recorded
+  // in it as soon as it is done (eval/view_journal.h). Not owned.
+  const ViewJournal* journal = nullptr;
 };
 
 // Loads every photo once (so that no view's time includes reading files) and returns the

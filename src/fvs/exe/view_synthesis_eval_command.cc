@@ -76,6 +76,10 @@ void AddSweepAndReportFlags(OptionManager* options, EvaluationOptions* o) {
                       "contact sheet tile width (0: no contact sheet)");
   options->AddDefault("write_images", &o->write_images,
                       "also write every render to O/renders/<configuration>/");
+  options->AddDefault(
+      "overwrite", &o->overwrite,
+      "evaluate every view again (default: the views a killed or earlier "
+      "run with the same settings finished, kept in O/views/, are reused)");
   options->AddDefault("fill_holes", &o->fill_holes,
                       "fill pixels no source sees from around them (0: black; the "
                       "covered-pixel scores are the same either way)");
