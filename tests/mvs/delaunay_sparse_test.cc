@@ -110,6 +110,12 @@ TEST(DelaunayMesherSparse, AdmitsSfmPointsSeenByEnoughFusedImages) {
   options.sparse_min_track_length = 3;
   EXPECT_EQ(ReadDenseMeshingInput(dir.path(), options).num_sparse_points, 2u);
 
+  // A fusion.cfg that cannot be read fails with SfM points and is not read without.
+  std::filesystem::create_directory(dir / "stereo/fusion.cfg");
+  EXPECT_THROW(ReadDenseMeshingInput(dir.path(), options), Error);
+  options.sparse_min_track_length = 0;
+  EXPECT_EQ(ReadDenseMeshingInput(dir.path(), options).num_sparse_points, 0u);
+
   options.sparse_min_track_length = -1;
   EXPECT_THROW(options.Check(), Error);
   options = DelaunayMeshingOptions();

@@ -82,6 +82,9 @@ std::vector<uint32_t> ReadImageIdsText(const std::string& path) {
 
 // The names in a COLMAP fusion.cfg (one image name per line; blank lines skipped).
 std::set<std::string> ReadFusionImageNames(const std::string& path) {
+  std::error_code ec;
+  // (A folder opens as a stream and reads as empty: no image would count as fused.)
+  Require(std::filesystem::is_regular_file(path, ec), path, "is not a file");
   std::ifstream file(path);
   Require(file.good(), path, "cannot open");
   std::set<std::string> names;
@@ -90,6 +93,7 @@ std::set<std::string> ReadFusionImageNames(const std::string& path) {
     line = TrimString(line);
     if (!line.empty()) names.insert(line);
   }
+  Require(!file.bad(), path, "read error");
   return names;
 }
 
@@ -240,7 +244,8 @@ DelaunayMeshingInput ReadDenseMeshingInput(const std::string& workspace_path,
   input.cameras.reserve(order.size());
   for (const uint32_t id : order) input.cameras.push_back(reconstruction.PinholeFor(id));
   const std::string fusion_cfg = workspace.StereoDir() + "/fusion.cfg";
-  if (std::filesystem::exists(fusion_cfg)) {
+  // Without SfM points (COLMAP's fused-only input) fusion.cfg is not read at all.
+  if (options.sparse_min_track_length > 0 && std::filesystem::exists(fusion_cfg)) {
     const std::set<std::string> fused_names = ReadFusionImageNames(fusion_cfg);
     AppendSparsePoints(reconstruction, order, &fused_names, options, &input);
   } else {
