@@ -11,7 +11,7 @@
 // does the work and states what is resumed and reported.
 #include "fvs/controllers/render_targets.h"
 #include "fvs/exe/command_registry.h"
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 
 namespace fvs {
 namespace {

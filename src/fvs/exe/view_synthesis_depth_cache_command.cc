@@ -6,7 +6,7 @@
 
 #include "fvs/controllers/workspace_stages.h"
 #include "fvs/exe/command_registry.h"
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 
 namespace fvs {
 namespace {

@@ -11,7 +11,7 @@
 // exit status is 1 when any view failed.
 #include "fvs/controllers/evaluation.h"
 #include "fvs/exe/command_registry.h"
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 
 namespace fvs {
 namespace {

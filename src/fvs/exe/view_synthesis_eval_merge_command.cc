@@ -8,7 +8,7 @@
 
 #include "fvs/controllers/evaluation_merge.h"
 #include "fvs/exe/command_registry.h"
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 
 namespace fvs {
 namespace {

@@ -6,7 +6,7 @@
 #include <iostream>
 
 #include "fvs/exe/command_registry.h"
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 #include "fvs/render/fvs_method.h"
 #include "fvs/train/finetune.h"
 

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "fvs/exe/command_registry.h"
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 #include "fvs/util/error.h"
 
 #ifdef FVS_WITH_GUI

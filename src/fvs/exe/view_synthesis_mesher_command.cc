@@ -11,7 +11,7 @@
 #include "colmap_ext/workspace.h"
 #include "fvs/controllers/workspace_stages.h"
 #include "fvs/exe/command_registry.h"
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 #include "fvs/mvs/delaunay.h"
 
 namespace fvs {

@@ -6,7 +6,7 @@
 #include <thread>
 
 #include "fvs/exe/command_registry.h"
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 #include "fvs/net/net.h"
 #include "fvs/util/error.h"
 #include "fvs/util/machine.h"

@@ -5,7 +5,7 @@
 #include <iostream>
 
 #include "fvs/exe/command_registry.h"
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 #include "fvs/scene/scene.h"
 #include "fvs/train/pack.h"
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "fvs/exe/command_registry.h"
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 #include "fvs/path/camera_path.h"
 #include "fvs/scene/scene.h"
 #include "fvs/util/error.h"

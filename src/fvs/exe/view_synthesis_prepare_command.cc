@@ -5,7 +5,7 @@
 // (controllers/prepare_workspace.h) does the work and states the rules.
 #include "fvs/controllers/prepare_workspace.h"
 #include "fvs/exe/command_registry.h"
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 
 namespace fvs {
 namespace {

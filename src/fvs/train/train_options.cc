@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "fvs/util/error.h"
+#include "fvs/util/option_manager.h"
 #include "fvs/util/parse_int.h"
 #include "fvs/util/string_util.h"
 
@@ -14,130 +15,6 @@ namespace fvs {
 namespace {
 
 const char kSubject[] = "view_synthesis_train";
-
-enum class Kind { kString, kInt, kDouble, kBool };
-
-struct OptionSpec {
-  std::string name;  // as documented (with "Train." for the tuning knobs)
-  Kind kind;
-  void* target;
-  bool required;
-  std::string help;
-};
-
-std::vector<OptionSpec> Specs(TrainOptions* o) {
-  return {
-      {"scene_list", Kind::kString, &o->scene_list, true,
-       "file listing packed scene folders (view_synthesis_pack), one per line"},
-      {"output_path", Kind::kString, &o->output_path, true,
-       "folder for checkpoints, validation.csv, model.safetensors, model.json"},
-      {"val_scene_list", Kind::kString, &o->val_scene_list, false,
-       "packed scenes held out for validation (optional)"},
-      {"vgg19_path", Kind::kString, &o->vgg19_path, false,
-       "VGG19 weights (.safetensors): L1 + perceptual loss instead of L1 + SSIM"},
-      {"lpips_path", Kind::kString, &o->lpips_path, false,
-       "LPIPS weights (.safetensors; default $FVS_LPIPS_PATH): validation reports LPIPS "
-       "and the default loss is L1 + LPIPS"},
-      {"Train.loss", Kind::kString, &o->loss, false,
-       "auto (l1+vgg19 with --vgg19_path, else l1+lpips with LPIPS weights, else "
-       "l1+ssim), l1+ssim, l1+lpips, l1+ssim+lpips or l1+vgg19"},
-      {"Train.lpips_weight", Kind::kDouble, &o->lpips_weight, false,
-       "weight of the LPIPS term of l1+lpips and l1+ssim+lpips"},
-      {"Train.variant", Kind::kString, &o->variant, false, "network variant"},
-      {"Train.init_weights", Kind::kString, &o->init_weights, false,
-       "start from these weights (.safetensors; their variant) instead of a fresh "
-       "network (a checkpoint in the output folder still resumes first)"},
-      {"Train.max_train_minutes", Kind::kDouble, &o->max_train_minutes, false,
-       "> 0: also stop and write the model once the training time of all invocations "
-       "reaches this"},
-      {"Train.device", Kind::kString, &o->device, false, "auto | cpu | cuda"},
-      {"Train.precision", Kind::kString, &o->precision, false,
-       "fp32 | bf16: bf16 runs the forward pass under autocast (fp32 weights, "
-       "gradients, optimiser and loss)"},
-      {"Train.max_steps", Kind::kInt, &o->max_steps, false, "optimiser steps in all"},
-      {"Train.num_sources", Kind::kInt, &o->num_sources, false,
-       "K: sources per target (top-K by overlap)"},
-      {"Train.crop", Kind::kInt, &o->crop, false, "square target crop in pixels"},
-      {"Train.source_margin", Kind::kInt, &o->source_margin, false,
-       "encode only the part of each source the crop samples, plus this margin in "
-       "pixels (-1: whole sources)"},
-      {"Train.batch_size", Kind::kInt, &o->batch_size, false,
-       "targets per optimiser step (gradients accumulated)"},
-      {"Train.learning_rate", Kind::kDouble, &o->learning_rate, false, "Adam step size"},
-      {"Train.checkpoint_minutes", Kind::kDouble, &o->checkpoint_minutes, false,
-       "minutes between checkpoints"},
-      {"Train.checkpoint_every_steps", Kind::kInt, &o->checkpoint_every_steps, false,
-       "also a checkpoint every N steps (0: off)"},
-      {"Train.keep_checkpoints", Kind::kInt, &o->keep_checkpoints, false,
-       "checkpoints kept (newest first)"},
-      {"Train.log_every", Kind::kInt, &o->log_every, false,
-       "steps between progress lines"},
-      {"Train.val_every", Kind::kInt, &o->val_every, false,
-       "steps between validation passes (0: only at the end)"},
-      {"Train.val_views", Kind::kInt, &o->val_views, false,
-       "held-out views per validation scene"},
-      {"Train.seed", Kind::kInt, &o->seed, false, "seed of initialisation and sampling"},
-      {"Train.augment", Kind::kBool, &o->augment, false, "photometric augmentation"},
-      {"Train.fp16_weights", Kind::kBool, &o->fp16_weights, false,
-       "write model.safetensors in fp16"},
-      {"Train.occlusion_tolerance", Kind::kDouble, &o->occlusion_tolerance, false,
-       "relative depth tolerance of a valid warp"},
-      {"Train.headroom", Kind::kBool, &o->headroom, false,
-       "only measure ulr and the per-pixel and global oracles on the validation "
-       "views (M/headroom.csv), no training"},
-      {"Train.benchmark", Kind::kBool, &o->benchmark, false,
-       "only the render benchmark: validation views of --val_scene_list rendered at "
-       "--Train.bench_sizes, K in --Train.bench_ks, --Train.bench_precisions "
-       "(M/render_benchmark.csv); weights of --Train.init_weights, else a fresh network"},
-      {"Train.bench_sizes", Kind::kString, &o->bench_sizes, false,
-       "render benchmark: WxH sizes, comma separated"},
-      {"Train.bench_ks", Kind::kString, &o->bench_ks, false,
-       "render benchmark: numbers of sources, comma separated, in the order run"},
-      {"Train.bench_precisions", Kind::kString, &o->bench_precisions, false,
-       "render benchmark: fp32, bf16, fp16 (fp16 on CUDA only)"},
-      {"Train.bench_seconds", Kind::kDouble, &o->bench_seconds, false,
-       "render benchmark: time bound; cells that would pass it are skipped"},
-      {"Train.bench_views", Kind::kInt, &o->bench_views, false,
-       "render benchmark: validation views per scene in each cell"},
-      {"Train.num_threads", Kind::kInt, &o->num_threads, false,
-       "LibTorch CPU threads (<= 0: FVS_NUM_THREADS or all cores)"},
-  };
-}
-
-bool ParseBool(const std::string& v, bool* out) {
-  if (v == "1" || v == "true" || v == "on" || v == "yes") return *out = true, true;
-  if (v == "0" || v == "false" || v == "off" || v == "no") return *out = false, true;
-  return false;
-}
-
-void Assign(const OptionSpec& spec, const std::string& value) {
-  const std::string what = "--" + spec.name + " " + value;
-  try {
-    size_t used = 0;
-    switch (spec.kind) {
-      case Kind::kString:
-        *static_cast<std::string*>(spec.target) = value;
-        return;
-      case Kind::kInt: {
-        const long long v = std::stoll(value, &used);
-        if (used != value.size() || v < -2147483648LL || v > 2147483647LL) break;
-        *static_cast<int*>(spec.target) = static_cast<int>(v);
-        return;
-      }
-      case Kind::kDouble: {
-        const double v = std::stod(value, &used);
-        if (used != value.size() || !std::isfinite(v)) break;
-        *static_cast<double*>(spec.target) = v;
-        return;
-      }
-      case Kind::kBool:
-        if (ParseBool(value, static_cast<bool*>(spec.target))) return;
-        break;
-    }
-  } catch (const std::exception&) {
-  }
-  throw Error(kSubject, "cannot parse the value of " + what);
-}
 
 }  // namespace
 
@@ -222,79 +99,107 @@ BenchmarkGrid ParseBenchmarkGrid(const TrainOptions& o) {
   return grid;
 }
 
-std::string TrainUsage(const std::string& program) {
-  TrainOptions defaults;
-  std::ostringstream s;
-  s << "Usage: " << program << " --scene_list L --output_path M [options]\n"
-    << "Trains the view-synthesis network on packed scenes (view_synthesis_pack); a run\n"
-    << "resumes from the newest valid checkpoint in M.\n\nOptions:\n";
-  TrainOptions tmp = defaults;
-  for (const OptionSpec& spec : Specs(&tmp)) {
-    s << "  --" << spec.name;
-    switch (spec.kind) {
-      case Kind::kString:
-        s << " <text>";
-        if (!static_cast<std::string*>(spec.target)->empty())
-          s << " (default " << *static_cast<std::string*>(spec.target) << ")";
-        break;
-      case Kind::kInt:
-        s << " <int> (default " << *static_cast<int*>(spec.target) << ")";
-        break;
-      case Kind::kDouble:
-        s << " <number> (default " << *static_cast<double*>(spec.target) << ")";
-        break;
-      case Kind::kBool:
-        s << " <0|1> (default " << *static_cast<bool*>(spec.target) << ")";
-        break;
-    }
-    s << (spec.required ? " [required]" : "") << "\n      " << spec.help << "\n";
-  }
-  return s.str();
+void AddTrainOptions(OptionManager* options, TrainOptions* o) {
+  options->AddRequired(
+      "scene_list", &o->scene_list,
+      "file listing packed scene folders (view_synthesis_pack), one per line");
+  options->AddRequired(
+      "output_path", &o->output_path,
+      "folder for checkpoints, validation.csv, model.safetensors, model.json");
+  options->AddDefault("val_scene_list", &o->val_scene_list,
+                      "packed scenes held out for validation (optional)");
+  options->AddDefault(
+      "vgg19_path", &o->vgg19_path,
+      "VGG19 weights (.safetensors): L1 + perceptual loss instead of L1 + SSIM");
+  options->AddDefault(
+      "lpips_path", &o->lpips_path,
+      "LPIPS weights (.safetensors; default $FVS_LPIPS_PATH): validation reports LPIPS "
+      "and the default loss is L1 + LPIPS");
+  options->AddDefault(
+      "Train.loss", &o->loss,
+      "auto (l1+vgg19 with --vgg19_path, else l1+lpips with LPIPS weights, else "
+      "l1+ssim), l1+ssim, l1+lpips, l1+ssim+lpips or l1+vgg19");
+  options->AddDefault("Train.lpips_weight", &o->lpips_weight,
+                      "weight of the LPIPS term of l1+lpips and l1+ssim+lpips");
+  options->AddDefault("Train.variant", &o->variant, "network variant");
+  options->AddDefault(
+      "Train.init_weights", &o->init_weights,
+      "start from these weights (.safetensors; their variant) instead of a fresh "
+      "network (a checkpoint in the output folder still resumes first)");
+  options->AddDefault(
+      "Train.max_train_minutes", &o->max_train_minutes,
+      "> 0: also stop and write the model once the training time of all invocations "
+      "reaches this");
+  options->AddDefault("Train.device", &o->device, "auto | cpu | cuda");
+  options->AddDefault(
+      "Train.precision", &o->precision,
+      "fp32 | bf16: bf16 runs the forward pass under autocast (fp32 weights, "
+      "gradients, optimiser and loss)");
+  options->AddDefault("Train.max_steps", &o->max_steps, "optimiser steps in all");
+  options->AddDefault("Train.num_sources", &o->num_sources,
+                      "K: sources per target (top-K by overlap)");
+  options->AddDefault("Train.crop", &o->crop, "square target crop in pixels");
+  options->AddDefault(
+      "Train.source_margin", &o->source_margin,
+      "encode only the part of each source the crop samples, plus this margin in "
+      "pixels (-1: whole sources)");
+  options->AddDefault("Train.batch_size", &o->batch_size,
+                      "targets per optimiser step (gradients accumulated)");
+  options->AddDefault("Train.learning_rate", &o->learning_rate, "Adam step size");
+  options->AddDefault("Train.checkpoint_minutes", &o->checkpoint_minutes,
+                      "minutes between checkpoints");
+  options->AddDefault("Train.checkpoint_every_steps", &o->checkpoint_every_steps,
+                      "also a checkpoint every N steps (0: off)");
+  options->AddDefault("Train.keep_checkpoints", &o->keep_checkpoints,
+                      "checkpoints kept (newest first)");
+  options->AddDefault("Train.log_every", &o->log_every, "steps between progress lines");
+  options->AddDefault("Train.val_every", &o->val_every,
+                      "steps between validation passes (0: only at the end)");
+  options->AddDefault("Train.val_views", &o->val_views,
+                      "held-out views per validation scene");
+  options->AddDefault("Train.seed", &o->seed, "seed of initialisation and sampling");
+  options->AddDefault("Train.augment", &o->augment, "photometric augmentation");
+  options->AddDefault("Train.fp16_weights", &o->fp16_weights,
+                      "write model.safetensors in fp16");
+  options->AddDefault("Train.occlusion_tolerance", &o->occlusion_tolerance,
+                      "relative depth tolerance of a valid warp");
+  options->AddDefault(
+      "Train.headroom", &o->headroom,
+      "only measure ulr and the per-pixel and global oracles on the validation "
+      "views (M/headroom.csv), no training");
+  options->AddDefault(
+      "Train.benchmark", &o->benchmark,
+      "only the render benchmark: validation views of --val_scene_list rendered at "
+      "--Train.bench_sizes, K in --Train.bench_ks, --Train.bench_precisions "
+      "(M/render_benchmark.csv); weights of --Train.init_weights, else a fresh network");
+  options->AddDefault("Train.bench_sizes", &o->bench_sizes,
+                      "render benchmark: WxH sizes, comma separated");
+  options->AddDefault(
+      "Train.bench_ks", &o->bench_ks,
+      "render benchmark: numbers of sources, comma separated, in the order run");
+  options->AddDefault("Train.bench_precisions", &o->bench_precisions,
+                      "render benchmark: fp32, bf16, fp16 (fp16 on CUDA only)");
+  options->AddDefault(
+      "Train.bench_seconds", &o->bench_seconds,
+      "render benchmark: time bound; cells that would pass it are skipped");
+  options->AddDefault("Train.bench_views", &o->bench_views,
+                      "render benchmark: validation views per scene in each cell");
+  options->AddDefault("Train.num_threads", &o->num_threads,
+                      "LibTorch CPU threads (<= 0: FVS_NUM_THREADS or all cores)");
 }
 
 bool ParseTrainOptions(int argc, char** argv, int first, TrainOptions* options) {
-  std::vector<OptionSpec> specs = Specs(options);
-  std::vector<bool> seen(specs.size(), false);
-  for (int i = first; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "-h" || arg == "--help") {
-      std::string program = argc > 0 ? argv[0] : "fvs_train_main";
-      if (first >= 2 && argc > 1) program += std::string(" ") + argv[1];
-      std::cout << TrainUsage(program);
-      return false;
-    }
-    Require(StartsWith(arg, "--") && arg.size() > 2, kSubject,
-            "unexpected argument '" + arg + "' (options are --name value)");
-    std::string name = arg.substr(2);
-    std::string value;
-    bool has_value = false;
-    const size_t eq = name.find('=');
-    if (eq != std::string::npos) {
-      value = name.substr(eq + 1);
-      name = name.substr(0, eq);
-      has_value = true;
-    }
-    size_t k = 0;
-    // "Train.x" and bare "x" both name option x.
-    for (; k < specs.size(); ++k) {
-      const std::string& n = specs[k].name;
-      if (n == name || (StartsWith(n, "Train.") && n.substr(6) == name) ||
-          ("Train." + n) == name) {
-        break;
-      }
-    }
-    Require(k < specs.size(), kSubject, "unknown option --" + name);
-    if (!has_value) {
-      Require(i + 1 < argc, kSubject, "option --" + name + " needs a value");
-      value = argv[++i];
-    }
-    Assign(specs[k], value);
-    seen[k] = true;
+  OptionManager manager(kSubject,
+                        "Trains the view-synthesis network on packed scenes "
+                        "(view_synthesis_pack); a run resumes from the newest valid "
+                        "checkpoint in --output_path.");
+  // The standalone trainer (first == 1) is its own program.
+  if (first < 2) {
+    manager.SetProgram(argc > 0 ? std::filesystem::path(argv[0]).filename().string()
+                                : "fvs_train_main");
   }
-  for (size_t k = 0; k < specs.size(); ++k) {
-    Require(!specs[k].required || seen[k], kSubject,
-            "missing required option --" + specs[k].name);
-  }
+  AddTrainOptions(&manager, options);
+  if (!manager.Parse(argc, argv, first)) return false;
   options->Check();
   return true;
 }

@@ -11,6 +11,8 @@
 
 namespace fvs {
 
+class OptionManager;
+
 struct TrainOptions {
   std::string scene_list;      // file: one packed scene folder per line
   std::string output_path;     // M/: checkpoints, validation.csv, model.safetensors
@@ -62,8 +64,8 @@ struct TrainOptions {
   // fresh --Train.variant: timing only) and ulr, into M/render_benchmark.csv; no
   // training.
   bool benchmark = false;
-  std::string bench_sizes = "480x270,960x540";  // WxH list
-  std::string bench_ks = "1,2,3,4,5,6,7,8";      // K list, in the order run
+  std::string bench_sizes = "480x270,960x540";      // WxH list
+  std::string bench_ks = "1,2,3,4,5,6,7,8";         // K list, in the order run
   std::string bench_precisions = "fp32,bf16,fp16";  // fp16 skipped on the CPU
   double bench_seconds = 240;  // the grid's time bound (cells that would pass it skipped)
   int bench_views = 1;         // validation views per scene per cell
@@ -83,12 +85,15 @@ struct BenchmarkGrid {
 };
 BenchmarkGrid ParseBenchmarkGrid(const TrainOptions& options);
 
-// Parses argv[first..argc): `--scene_list L`, `--Train.max_steps N`, ... (every option
-// has a `Train.` name; the path options also a bare one). Returns false when help was
-// asked for (printed to stdout). Throws fvs::Error naming an unknown option, a missing or
-// malformed value, or a missing required option.
+// Registers the trainer's options (`--scene_list L`, `--Train.max_steps N`, ...; the
+// short `--max_steps` works too) bound to the fields of *o.
+void AddTrainOptions(OptionManager* options, TrainOptions* o);
+
+// Parses argv[first..argc) (first = 2 under the front door, 1 for fvs_train_main) and
+// checks the result. Returns false when help was asked for (printed to stdout). Throws
+// fvs::Error naming an unknown option, a missing or malformed value, a missing required
+// option or a value Check() refuses.
 bool ParseTrainOptions(int argc, char** argv, int first, TrainOptions* options);
-std::string TrainUsage(const std::string& program);
 
 // Reads a scene list: one folder per line; blank lines and lines starting with '#' are
 // skipped; relative paths are relative to the list's folder. Throws fvs::Error

@@ -1,4 +1,4 @@
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 
 #include <gtest/gtest.h>
 
@@ -71,6 +71,50 @@ TEST(OptionManager, HelpReturnsFalseAndListsOptions) {
   const std::string out = testing::internal::GetCapturedStdout();
   EXPECT_NE(out.find("--Stereo.backend"), std::string::npos);
   EXPECT_NE(out.find("(required)"), std::string::npos);
+}
+
+TEST(OptionManager, ShortFormsAndBooleanWords) {
+  Values v;
+  OptionManager options = MakeOptions(&v);
+  Argv a({"colmap", "view_synthesis_test", "--workspace_path", "w", "--backend", "colmap",
+          "--tolerance=0.5", "--flag", "Yes"});
+  ASSERT_TRUE(options.Parse(a.argc(), a.argv()));
+  EXPECT_EQ(v.backend, "colmap");
+  EXPECT_DOUBLE_EQ(v.tolerance, 0.5);
+  EXPECT_TRUE(v.flag);
+  Argv off({"colmap", "view_synthesis_test", "--workspace_path", "w", "--flag", "off"});
+  ASSERT_TRUE(options.Parse(off.argc(), off.argv()));
+  EXPECT_FALSE(v.flag);
+
+  // Two sections with the same option: the short form is ambiguous.
+  double other = 0;
+  options.AddDefault("Stereo.tolerance", &other, "another tolerance");
+  Argv ambiguous({"colmap", "view_synthesis_test", "--workspace_path", "w", "--tolerance",
+                  "1"});
+  try {
+    options.Parse(ambiguous.argc(), ambiguous.argv());
+    ADD_FAILURE() << "no error for an ambiguous short form";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("ambiguous"), std::string::npos) << e.what();
+  }
+}
+
+TEST(OptionManager, ProgramNamesUsageAndErrors) {
+  Values v;
+  OptionManager options = MakeOptions(&v);
+  options.SetProgram("fvs_train_main");
+  Argv a({"fvs_train_main", "-h"});
+  testing::internal::CaptureStdout();
+  EXPECT_FALSE(options.Parse(a.argc(), a.argv(), 1));
+  EXPECT_NE(testing::internal::GetCapturedStdout().find("Usage: fvs_train_main [options]"),
+            std::string::npos);
+  Argv bad({"fvs_train_main", "--nope", "1"});
+  try {
+    options.Parse(bad.argc(), bad.argv(), 1);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("fvs_train_main", 0), 0u) << e.what();
+  }
 }
 
 TEST(OptionManager, BadInputThrowsOneLine) {

@@ -1,5 +1,6 @@
-#include "fvs/exe/option_manager.h"
+#include "fvs/util/option_manager.h"
 
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <climits>
@@ -20,12 +21,13 @@ std::string StripDashes(const std::string& arg) {
   return arg.substr(i);
 }
 
-bool ParseBool(const std::string& s, bool* value) {
-  if (s == "1" || s == "true" || s == "True" || s == "TRUE") {
+bool ParseBool(std::string s, bool* value) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (s == "1" || s == "true" || s == "on" || s == "yes") {
     *value = true;
     return true;
   }
-  if (s == "0" || s == "false" || s == "False" || s == "FALSE") {
+  if (s == "0" || s == "false" || s == "off" || s == "no") {
     *value = false;
     return true;
   }
@@ -35,7 +37,30 @@ bool ParseBool(const std::string& s, bool* value) {
 }  // namespace
 
 OptionManager::OptionManager(std::string command, std::string description)
-    : command_(std::move(command)), description_(std::move(description)) {}
+    : command_(std::move(command)),
+      program_("colmap " + command_),
+      description_(std::move(description)) {}
+
+void OptionManager::SetProgram(std::string program) { program_ = std::move(program); }
+
+OptionManager::Option* OptionManager::Find(const std::string& name) {
+  for (Option& o : options_) {
+    if (o.name == name) return &o;
+  }
+  // The short form of --Section.name, when only one option ends in it.
+  Option* found = nullptr;
+  for (Option& o : options_) {
+    const size_t dot = o.name.rfind('.');
+    if (dot == std::string::npos || o.name.compare(dot + 1, std::string::npos, name) != 0)
+      continue;
+    if (found) {
+      throw Error(program_, "option --" + name + " is ambiguous: --" + found->name +
+                                " or --" + o.name);
+    }
+    found = &o;
+  }
+  return found;
+}
 
 void OptionManager::Add(const std::string& name, Option::Kind kind, void* target,
                         bool required, const std::string& help) {
@@ -99,8 +124,7 @@ std::string OptionManager::ValueString(const Option& option) const {
 
 std::string OptionManager::Usage() const {
   std::ostringstream s;
-  s << "Usage: colmap " << command_ << " [options]\n\n"
-    << description_ << "\n\nOptions:\n";
+  s << "Usage: " << program_ << " [options]\n\n" << description_ << "\n\nOptions:\n";
   s << "  -h [ --help ]\n";
   for (const Option& o : options_) {
     s << "  --" << o.name;
@@ -135,7 +159,7 @@ bool OptionManager::Parse(int argc, char** argv, int first) {
   for (int i = first; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg.size() < 2 || arg[0] != '-') {
-      throw Error("colmap " + command_,
+      throw Error(program_,
                   "unexpected argument '" + arg + "' (options are --name value; see -h)");
     }
     std::string name = StripDashes(arg);
@@ -147,20 +171,15 @@ bool OptionManager::Parse(int argc, char** argv, int first) {
       name = name.substr(0, eq);
       has_value = true;
     }
-    Option* option = nullptr;
-    for (Option& o : options_) {
-      if (o.name == name) option = &o;
-    }
+    Option* option = Find(name);
     if (option == nullptr) {
-      throw Error("colmap " + command_, "unknown option --" + name + " (see -h)");
+      throw Error(program_, "unknown option --" + name + " (see -h)");
     }
     if (!has_value) {
-      if (i + 1 >= argc) {
-        throw Error("colmap " + command_, "option --" + name + " needs a value");
-      }
+      if (i + 1 >= argc) throw Error(program_, "option --" + name + " needs a value");
       value = argv[++i];
     }
-    const std::string where = "colmap " + command_;
+    const std::string& where = program_;
     switch (option->kind) {
       case Option::Kind::kString:
         *static_cast<std::string*>(option->target) = value;
@@ -190,8 +209,9 @@ bool OptionManager::Parse(int argc, char** argv, int first) {
       case Option::Kind::kBool: {
         bool v = false;
         if (!ParseBool(value, &v)) {
-          throw Error(
-              where, "option --" + name + " expects 0/1/true/false, got '" + value + "'");
+          throw Error(where, "option --" + name +
+                                 " expects 1/0, true/false, on/off or yes/no, got '" +
+                                 value + "'");
         }
         *static_cast<bool*>(option->target) = v;
         break;
@@ -201,7 +221,7 @@ bool OptionManager::Parse(int argc, char** argv, int first) {
   }
   for (const Option& o : options_) {
     if (o.required && !o.seen) {
-      throw Error("colmap " + command_, "missing required option --" + o.name);
+      throw Error(program_, "missing required option --" + o.name);
     }
   }
   return true;
