@@ -5,10 +5,17 @@
 # (edges, "cov") and the findings; a finding's input is saved under
 # build-fuzz/findings/<target>/ (reproduce: build-fuzz/bin/fuzz/<target>_fuzzer FILE).
 #   scripts/fuzz.sh [SECONDS] [TARGET...]      e.g. scripts/fuzz.sh 120 ply safetensors
+#   scripts/fuzz.sh --smoke                    the CI step (scripts/test.sh): the ctest
+#       of build-fuzz, every target over its seeds and 5 s of mutations (about a minute)
 # Exits 1 when any target had a finding. doc/reliability.md ("Fuzzing") has the results.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+SMOKE=0
+if [[ "${1:-}" == "--smoke" ]]; then
+  SMOKE=1
+  shift
+fi
 SECONDS_PER_TARGET="${1:-60}"
 shift || true
 BUILD_DIR="${FVS_FUZZ_BUILD_DIR:-build-fuzz}"
@@ -22,6 +29,11 @@ if [[ ! -f "$BUILD_DIR/build.ninja" ]]; then
     -DCMAKE_BUILD_TYPE=RelWithDebInfo
 fi
 cmake --build "$BUILD_DIR" -j "$JOBS"
+
+if [[ $SMOKE == 1 ]]; then
+  ctest --test-dir "$BUILD_DIR" -L fuzz --output-on-failure -j "$JOBS"
+  exit $?
+fi
 
 if [[ $# -gt 0 ]]; then
   targets=("$@")
