@@ -69,7 +69,7 @@ TEST(Jobs, EvaluationScoresEveryTargetAndWritesItsReports) {
   options.output_path = dir / "eval";
   options.protocol.protocol = "leave_one_out";
   options.protocol.every = 2;
-  options.num_threads = 2;
+  options.render.num_threads = 2;
   const EvaluationResult result = RunEvaluation(options);
   ASSERT_EQ(result.targets.size(), 3u);
   ASSERT_EQ(result.results.size(), 3u);

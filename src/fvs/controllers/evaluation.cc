@@ -52,10 +52,7 @@ std::vector<std::string> ProtocolNotes(const TargetSet& set, const Shard& shard,
 // The render options every configuration shares (checked).
 EvalRunOptions BaseRunOptions(const EvaluationOptions& o) {
   EvalRunOptions run;
-  run.render.num_threads = o.num_threads;
-  run.render.max_num_sources = o.max_num_sources;
-  run.render.fill_holes = o.fill_holes;
-  run.render.device = o.device;
+  run.render = o.render;
   run.render.scene_model_dir = WorkspaceFinetunedModelDir(o.workspace_path);
   run.render.Check();
   return run;
@@ -142,9 +139,14 @@ std::string JournalSettings(const EvaluationOptions& o,
     json["configurations"].push_back({c.Label(), FileHashOrEmpty(weights)});
   }
   json["lpips_hash"] = FileHashOrEmpty(ResolveLpipsPath(o.lpips_path));
-  json["max_num_sources"] = o.max_num_sources;
-  json["fill_holes"] = o.fill_holes;
-  json["device"] = o.device;
+  const RenderOptions& r = o.render;
+  json["render"] = {{"max_num_sources", r.max_num_sources},
+                    {"selection_tolerance", r.selection_tolerance},
+                    {"warp_tolerance", r.warp_tolerance},
+                    {"fill_holes", r.fill_holes},
+                    {"device", r.device},
+                    {"tile_size", r.tile_size},
+                    {"tile_overlap", r.tile_overlap}};
   json["thumbnail_width"] = o.thumbnail_width;
   json["write_images"] = o.write_images;
   return json.dump(2) + "\n";
@@ -157,7 +159,7 @@ void EvaluationOptions::Check() const {
   Shard::Parse(shard);
   Require(config.num_sources >= 0, "--num_sources",
           "must be at least 1, or 0 (adaptive)");
-  Require(max_num_sources >= 1, "--max_num_sources", "must be at least 1");
+  Require(render.max_num_sources >= 1, "--max_num_sources", "must be at least 1");
   Require(config.scale > 0 && config.scale <= 4, "--scale", "must be in (0, 4]");
   eval::ParseTimeMeasure(time);
   Require(thumbnail_width >= 0, "--thumbnail_width", "must not be negative");
@@ -173,7 +175,7 @@ EvaluationResult RunEvaluation(const EvaluationOptions& o) {
   const std::vector<EvalConfig> configs = PlanConfigs(o, run.render, &notes);
   LoadLpipsInto(o, &run, &notes);
 
-  const Scene scene = Scene::Load(o.workspace_path, {true, o.num_threads});
+  const Scene scene = Scene::Load(o.workspace_path, {true, o.render.num_threads});
   std::vector<std::string> names;
   for (const SceneView& v : scene.views()) names.push_back(v.name);
   const TargetSet set =

@@ -40,10 +40,9 @@ struct EvaluationOptions {
   bool write_images = false;  // every render to <output_path>/renders/<configuration>/
   bool overwrite =
       false;  // evaluate every view again (else <output_path>/views/ resumes)
-  int num_threads = 0;
-  int max_num_sources = RenderOptions().max_num_sources;
-  bool fill_holes = true;
-  std::string device = "auto";
+  // The renderer's engine (sources, tolerances, holes, device, tiles, threads). Its
+  // num_sources, model_path and precision are not used: `config` (or the sweep) has them.
+  RenderOptions render;
 
   // Throws fvs::Error with one line naming the option that is wrong.
   void Check() const;

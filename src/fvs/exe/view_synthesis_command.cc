@@ -11,6 +11,7 @@
 // does the work and states what is resumed and reported.
 #include "fvs/controllers/render_targets.h"
 #include "fvs/exe/command_registry.h"
+#include "fvs/exe/render_flags.h"
 #include "fvs/util/option_manager.h"
 
 namespace fvs {
@@ -36,12 +37,6 @@ void AddMethodFlags(OptionManager* options, RenderTargetsOptions* o) {
                       "network weights (--method fvs)");
   options->AddDefault("num_sources", &o->render.num_sources,
                       "K sources per target; 0 = adaptive, up to --max_num_sources");
-  options->AddDefault("max_num_sources", &o->render.max_num_sources,
-                      "the most sources an adaptive K (0) takes");
-  options->AddDefault("selection_tolerance", &o->render.selection_tolerance,
-                      "relative depth tolerance for ranking sources");
-  options->AddDefault("warp_tolerance", &o->render.warp_tolerance,
-                      "relative occlusion tolerance when warping");
   options->AddDefault("width", &o->width, "output width (0: the target camera's)");
   options->AddDefault("height", &o->height, "output height (0: the target camera's)");
   options->AddDefault("scale", &o->scale, "scale of the output size");
@@ -60,20 +55,13 @@ void AddOutputFlags(OptionManager* options, RenderTargetsOptions* o) {
                       "background at infinity)");
   options->AddDefault("write_sources", &o->output.write_sources,
                       "also write <name>.sources.json");
-  options->AddDefault("fill_holes", &o->render.fill_holes,
-                      "fill pixels no source sees from the covered pixels around them "
-                      "(0: leave them black; frame_report.csv counts them either way)");
 }
 
-// The network methods' device, precision, caches and tiles; threads.
+// The network methods' precision and disk cache (the rest of the engine's flags are
+// AddRenderEngineFlags).
 void AddNetworkFlags(OptionManager* options, RenderTargetsOptions* o) {
-  options->AddDefault("device", &o->render.device,
-                      "--method fvs: auto (CUDA when there is one), cpu or cuda");
   options->AddDefault("precision", &o->render.precision,
                       "--method fvs: fp32, bf16, or fp16 (CUDA only)");
-  options->AddDefault("feature_cache_mb", &o->render.feature_cache_mb,
-                      "--method fvs: memory for encoded source features kept across "
-                      "targets (0: none)");
   options->AddDefault("disk_feature_cache", &o->disk_feature_cache,
                       "--method fvs: also keep encoded source features in "
                       "W/fvs/features/, read by later runs instead of encoding (about "
@@ -82,14 +70,6 @@ void AddNetworkFlags(OptionManager* options, RenderTargetsOptions* o) {
       "feature_cache_disk_mb", &o->render.feature_cache_disk_mb,
       "--disk_feature_cache: size limit of W/fvs/features (least recently "
       "used out first)");
-  options->AddDefault("tile_size", &o->render.tile_size,
-                      "--method fvs: blend targets larger than this in tiles of at most "
-                      "this size, to bound memory and stay in cache (0: never; -1: the "
-                      "network's own, 160 for fvs_agg, 512 for the others)");
-  options->AddDefault("tile_overlap", &o->render.tile_overlap,
-                      "--method fvs: pixels of context around each tile (-1: the "
-                      "network's own, 24 for fvs_agg, 32 for the others)");
-  options->AddDefault("num_threads", &o->render.num_threads, "threads (0: all cores)");
 }
 
 // Videos: encoding, resuming, temporal stability, reports, shards.
@@ -131,6 +111,7 @@ int RunViewSynthesis(int argc, char** argv) {
       "Render novel views of a prepared workspace (view_synthesis_prepare).");
   AddTargetFlags(&options, &o);
   AddMethodFlags(&options, &o);
+  AddRenderEngineFlags(&options, &o.render);
   AddOutputFlags(&options, &o);
   AddNetworkFlags(&options, &o);
   AddSequenceFlags(&options, &o);

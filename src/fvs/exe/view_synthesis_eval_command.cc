@@ -11,6 +11,7 @@
 // exit status is 1 when any view failed.
 #include "fvs/controllers/evaluation.h"
 #include "fvs/exe/command_registry.h"
+#include "fvs/exe/render_flags.h"
 #include "fvs/util/option_manager.h"
 
 namespace fvs {
@@ -37,8 +38,6 @@ void AddProtocolFlags(OptionManager* options, EvaluationOptions* o) {
   options->AddDefault("model_path", &o->config.model_path, "network weights");
   options->AddDefault("num_sources", &o->config.num_sources,
                       "K sources per target; 0 = adaptive, up to --max_num_sources");
-  options->AddDefault("max_num_sources", &o->max_num_sources,
-                      "the most sources an adaptive K (0, auto) takes");
   options->AddDefault("scale", &o->config.scale,
                       "render at this fraction of the photo size (upsampled to score)");
 }
@@ -54,7 +53,6 @@ void AddSweepAndReportFlags(OptionManager* options, EvaluationOptions* o) {
   options->AddDefault("sweep_scales", &o->sweep_options.scales, "resolution scales");
   options->AddDefault("precision", &o->config.precision,
                       "network methods: fp32, bf16, or fp16 (CUDA only)");
-  options->AddDefault("device", &o->device, "network methods: auto, cpu or cuda");
   options->AddDefault("sweep_precisions", &o->sweep_options.precisions,
                       "precisions of the network methods: fp32, bf16 (CPU or CUDA), fp16 "
                       "(CUDA)");
@@ -80,10 +78,6 @@ void AddSweepAndReportFlags(OptionManager* options, EvaluationOptions* o) {
       "overwrite", &o->overwrite,
       "evaluate every view again (default: the views a killed or earlier "
       "run with the same settings finished, kept in O/views/, are reused)");
-  options->AddDefault("fill_holes", &o->fill_holes,
-                      "fill pixels no source sees from around them (0: black; the "
-                      "covered-pixel scores are the same either way)");
-  options->AddDefault("num_threads", &o->num_threads, "threads (0: all cores)");
 }
 
 int RunViewSynthesisEval(int argc, char** argv) {
@@ -93,6 +87,7 @@ int RunViewSynthesisEval(int argc, char** argv) {
                         "against the photos (PSNR, SSIM, LPIPS) beside their run time.");
   AddProtocolFlags(&options, &o);
   AddSweepAndReportFlags(&options, &o);
+  AddRenderEngineFlags(&options, &o.render);
   if (!options.Parse(argc, argv)) return 0;
   const EvaluationResult result = RunEvaluation(o);
   PrintEvaluationSummary(o, result);

@@ -6,9 +6,9 @@
 #include <iostream>
 
 #include "fvs/exe/command_registry.h"
-#include "fvs/util/option_manager.h"
 #include "fvs/render/fvs_method.h"
 #include "fvs/train/finetune.h"
+#include "fvs/util/option_manager.h"
 
 namespace fvs {
 namespace {

@@ -4,8 +4,8 @@
 #include <string>
 
 #include "fvs/exe/command_registry.h"
-#include "fvs/util/option_manager.h"
 #include "fvs/util/error.h"
+#include "fvs/util/option_manager.h"
 
 #ifdef FVS_WITH_GUI
 #include <QApplication>

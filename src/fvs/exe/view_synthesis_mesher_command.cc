@@ -11,8 +11,8 @@
 #include "colmap_ext/workspace.h"
 #include "fvs/controllers/workspace_stages.h"
 #include "fvs/exe/command_registry.h"
-#include "fvs/util/option_manager.h"
 #include "fvs/mvs/delaunay.h"
+#include "fvs/util/option_manager.h"
 
 namespace fvs {
 namespace {

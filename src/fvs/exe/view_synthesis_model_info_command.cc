@@ -6,10 +6,10 @@
 #include <thread>
 
 #include "fvs/exe/command_registry.h"
-#include "fvs/util/option_manager.h"
 #include "fvs/net/net.h"
 #include "fvs/util/error.h"
 #include "fvs/util/machine.h"
+#include "fvs/util/option_manager.h"
 #include "fvs/util/string_util.h"
 
 namespace fvs {

@@ -5,9 +5,9 @@
 #include <iostream>
 
 #include "fvs/exe/command_registry.h"
-#include "fvs/util/option_manager.h"
 #include "fvs/scene/scene.h"
 #include "fvs/train/pack.h"
+#include "fvs/util/option_manager.h"
 
 namespace fvs {
 namespace {

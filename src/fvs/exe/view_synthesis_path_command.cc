@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "fvs/exe/command_registry.h"
-#include "fvs/util/option_manager.h"
 #include "fvs/path/camera_path.h"
 #include "fvs/scene/scene.h"
 #include "fvs/util/error.h"
+#include "fvs/util/option_manager.h"
 #include "fvs/util/progress.h"
 #include "fvs/util/string_util.h"
 

@@ -34,8 +34,9 @@ int RunPrepare(int argc, char** argv) {
                      "auto (COLMAP when it has CUDA), colmap, builtin");
   options.AddDefault("Stereo.max_image_size", &o.stereo_max_image_size,
                      "longest side for stereo (0 = undistorted size)");
-  options.AddDefault("Mesher.backend", &o.mesher_backend,
-                     "auto (builtin: COLMAP's algorithm with SfM points), colmap, builtin");
+  options.AddDefault(
+      "Mesher.backend", &o.mesher_backend,
+      "auto (builtin: COLMAP's algorithm with SfM points), colmap, builtin");
   options.AddDefault(
       "holdout_images", &o.holdout_images,
       "images registered by SfM but kept out of stereo, fusion and meshing: "

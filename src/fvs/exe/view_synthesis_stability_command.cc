@@ -12,10 +12,10 @@
 #include "fvs/eval/report.h"
 #include "fvs/eval/stability.h"
 #include "fvs/exe/command_registry.h"
-#include "fvs/util/option_manager.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
 #include "fvs/util/machine.h"
+#include "fvs/util/option_manager.h"
 #include "fvs/util/string_util.h"
 
 namespace fvs {

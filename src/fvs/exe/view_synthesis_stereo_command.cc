@@ -10,9 +10,9 @@
 
 #include "fvs/controllers/workspace_stages.h"
 #include "fvs/exe/command_registry.h"
-#include "fvs/util/option_manager.h"
 #include "fvs/mvs/patch_match_stereo.h"
 #include "fvs/util/error.h"
+#include "fvs/util/option_manager.h"
 
 namespace fvs {
 namespace {

@@ -5,10 +5,10 @@
 #include <string>
 
 #include "fvs/exe/command_registry.h"
-#include "fvs/util/option_manager.h"
 #include "fvs/render/targets.h"
 #include "fvs/synthetic/generate.h"
 #include "fvs/util/error.h"
+#include "fvs/util/option_manager.h"
 #include "fvs/util/progress.h"
 
 namespace fvs {
