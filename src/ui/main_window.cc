@@ -352,7 +352,7 @@ void MainWindow::SetInitialSettings(const QString& method, const QString& model_
   }
 }
 
-QString MainWindow::CannotRenderReason(const RenderRequest& request) const {
+QString MainWindow::CannotRenderReason(const NovelViewOptions& request) const {
   if (!contents_) return "No workspace is open: File > Open workspace first.";
   if (!contents_->can_render()) {
     return "Rendering is not available: " +
@@ -372,8 +372,8 @@ QString MainWindow::CannotRenderReason(const RenderRequest& request) const {
   return QString();
 }
 
-RenderRequest MainWindow::CurrentRequest() const {
-  RenderRequest request;
+NovelViewOptions MainWindow::CurrentRequest() const {
+  NovelViewOptions request;
   request.method = method_->currentText().toStdString();
   request.num_sources = num_sources_->value();
   request.width = width_->value();
@@ -387,7 +387,7 @@ RenderRequest MainWindow::CurrentRequest() const {
 }
 
 PinholeCamera MainWindow::CurrentTargetCamera() const {
-  const RenderRequest request = CurrentRequest();
+  const NovelViewOptions request = CurrentRequest();
   return TargetCameraFor(scene_view_->ViewCamera(), request.width, request.height);
 }
 
@@ -396,7 +396,7 @@ void MainWindow::RenderCurrentView() {
     ShowError("Busy: " + runner_->label() + " (wait for it or Cancel it)");
     return;
   }
-  const RenderRequest request = CurrentRequest();
+  const NovelViewOptions request = CurrentRequest();
   const QString reason = CannotRenderReason(request);
   if (!reason.isEmpty()) {
     ShowError(reason);

@@ -12,7 +12,7 @@
 #include <functional>
 #include <memory>
 
-#include "ui/render_request.h"
+#include "ui/novel_view.h"
 #include "ui/workspace_contents.h"
 
 class QAction;
@@ -72,10 +72,10 @@ class MainWindow : public QMainWindow {
   PathPanel* path_panel() const { return path_panel_; }
   TaskRunner* task_runner() const { return runner_; }
   // The render settings as chosen in the panel.
-  RenderRequest CurrentRequest() const;
+  NovelViewOptions CurrentRequest() const;
   // Why the request cannot be rendered now (no workspace, no mesh, no weights, a bad
   // setting), empty when it can.
-  QString CannotRenderReason(const RenderRequest& request) const;
+  QString CannotRenderReason(const NovelViewOptions& request) const;
   // The target camera of the current viewpoint at the chosen size (scene frame).
   PinholeCamera CurrentTargetCamera() const;
 

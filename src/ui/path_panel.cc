@@ -162,7 +162,7 @@ CameraPathOptions PathPanel::Options() const {
   options.fps = fps_->value();
   options.seconds_per_keyframe = seconds_per_key_->value();
   options.smooth = smooth_->isChecked();
-  const RenderRequest request = window_->CurrentRequest();
+  const NovelViewOptions request = window_->CurrentRequest();
   options.width = request.width;
   options.height = request.height;
   return options;
@@ -340,7 +340,7 @@ void PathPanel::Load() {
 }
 
 void PathPanel::RenderPath() {
-  const RenderRequest request = window_->CurrentRequest();
+  const NovelViewOptions request = window_->CurrentRequest();
   QString reason = window_->CannotRenderReason(request);
   if (reason.isEmpty() && keyframes_.empty()) reason = "Add keyframes first.";
   if (!reason.isEmpty()) {

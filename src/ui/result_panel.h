@@ -6,7 +6,7 @@
 #include <QWidget>
 #include <memory>
 
-#include "ui/render_request.h"
+#include "ui/novel_view.h"
 #include "ui/workspace_contents.h"
 
 class QButtonGroup;

@@ -98,7 +98,7 @@ void WriteMerged(const MergeEvaluationsOptions& o, size_t num_inputs,
   fs::create_directories(o.output_path, ec);
   Require(!ec, o.output_path, "cannot create the output folder: " + ec.message());
   const std::vector<eval::ConfigSummary> summary = eval::Summarize(shards.results, time);
-  eval::ReportContext context;
+  eval::ReportHeader context;
   context.title = "view_synthesis_eval (merged from " + std::to_string(num_inputs) +
                   " shard folders)";
   for (const std::string& m : shards.machines) {

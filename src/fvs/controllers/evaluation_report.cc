@@ -13,7 +13,7 @@ namespace fvs {
 
 void WriteEvaluationReports(const EvaluationOptions& o, const EvaluationResult& result,
                             const ContactSheetViews& sheet, size_t num_configs) {
-  eval::ReportContext context;
+  eval::ReportHeader context;
   context.title = "view_synthesis_eval: " + result.scene_name;
   context.machine = result.machine;
   context.workspace = o.workspace_path;

@@ -278,7 +278,7 @@ void WriteSummaryCsv(const std::string& path, const std::vector<ConfigSummary>& 
   });
 }
 
-void WriteMarkdownReport(const std::string& path, const ReportContext& context,
+void WriteMarkdownReport(const std::string& path, const ReportHeader& context,
                          const std::vector<ViewResult>& results,
                          const std::vector<ConfigSummary>& summary) {
   auto cell = [](const std::string& s) {

@@ -46,13 +46,13 @@ void WriteResultsCsv(const std::string& path, const std::vector<ViewResult>& res
 std::vector<ViewResult> ReadResultsCsv(const std::string& path);
 void WriteSummaryCsv(const std::string& path, const std::vector<ConfigSummary>& summary);
 
-struct ReportContext {
+struct ReportHeader {
   std::string title = "Evaluation";
   std::string machine;             // DescribeMachine()
   std::string workspace;           // what was evaluated
   std::vector<std::string> notes;  // one bullet each
 };
-void WriteMarkdownReport(const std::string& path, const ReportContext& context,
+void WriteMarkdownReport(const std::string& path, const ReportHeader& context,
                          const std::vector<ViewResult>& results,
                          const std::vector<ConfigSummary>& summary);
 

@@ -11,7 +11,7 @@
 
 namespace fvs::ui {
 
-struct RenderRequest {
+struct NovelViewOptions {
   std::string method = "ulr";
   int num_sources = 0;  // 0 = auto (RenderOptions::num_sources)
   int width = 640;
@@ -44,6 +44,6 @@ PinholeCamera TargetCameraFor(const PinholeCamera& view, int width, int height);
 // Creates the method and renders one view. Throws fvs::Error (no weights, a bad setting,
 // a failed render) with one line naming what is wrong.
 RenderedView RenderNovelView(const Scene& scene, const PinholeCamera& scene_camera,
-                             const RenderRequest& request);
+                             const NovelViewOptions& request);
 
 }  // namespace fvs::ui

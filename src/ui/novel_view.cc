@@ -1,4 +1,4 @@
-#include "ui/render_request.h"
+#include "ui/novel_view.h"
 
 #include <cmath>
 
@@ -7,14 +7,14 @@
 
 namespace fvs::ui {
 
-void RenderRequest::Check() const {
+void NovelViewOptions::Check() const {
   Require(!method.empty(), "method", "no rendering method chosen");
   Require(num_sources >= 0, "K", "needs at least one source, or auto (0)");
   Require(width >= 8 && height >= 8 && width <= 8192 && height <= 8192, "resolution",
           "width and height must be between 8 and 8192 pixels");
 }
 
-RenderOptions RenderRequest::ToRenderOptions() const {
+RenderOptions NovelViewOptions::ToRenderOptions() const {
   RenderOptions options;
   options.num_sources = num_sources;
   options.model_path = model_path;
@@ -36,7 +36,7 @@ PinholeCamera TargetCameraFor(const PinholeCamera& view, int width, int height) 
 }
 
 RenderedView RenderNovelView(const Scene& scene, const PinholeCamera& scene_camera,
-                             const RenderRequest& request) {
+                             const NovelViewOptions& request) {
   request.Check();
   Require(scene_camera.IsValid(), "target camera", "the view's camera is not valid");
   const Timer timer;
