@@ -231,9 +231,13 @@ TEST_F(TrainerTest, CorruptNewestCheckpointFallsBackToThePrevious) {
     out.write(bytes.data(), bytes.size() / 3);
   }
   {
-    Trainer trainer(o);
+    // A resumed run takes the command line's step size, not the one Adam saved.
+    TrainOptions smaller = o;
+    smaller.learning_rate = o.learning_rate / 4;
+    Trainer trainer(smaller);
     EXPECT_EQ(trainer.resumed_from(), 2);
     EXPECT_EQ(trainer.step(), 2);
+    EXPECT_DOUBLE_EQ(trainer.learning_rate(), o.learning_rate / 4);
   }
   // Both unusable: a clear error rather than a silent fresh start.
   {

@@ -129,6 +129,12 @@ bool Trainer::LoadCheckpoint(const std::string& path, std::string* why) {
       for (size_t i = 0; i < dbuf.size(); ++i) dbuf[i].copy_(sbuf[i].to(device_));
     }
     optimizer_->load(optimizer);
+    // Adam's state keeps the step size it was saved with; the command line's wins, so
+    // that a run can go on at a smaller one.
+    for (auto& group : optimizer_->param_groups()) {
+      static_cast<torch::optim::AdamOptions&>(group.options())
+          .lr(options_.learning_rate);
+    }
     sampler_->SetState(TensorString(sampler_state));
     {
       auto generator = at::detail::getDefaultCPUGenerator();

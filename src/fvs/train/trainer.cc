@@ -275,6 +275,12 @@ void Trainer::LoadLpipsWeights() {
   lpips_->eval();
 }
 
+double Trainer::learning_rate() const {
+  return static_cast<const torch::optim::AdamOptions&>(
+             optimizer_->param_groups().front().options())
+      .lr();
+}
+
 LossValue Trainer::Step() {
   net_->train();
   optimizer_->zero_grad();

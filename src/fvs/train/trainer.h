@@ -65,6 +65,9 @@ class Trainer {
   double train_seconds() const { return train_seconds_; }  // all invocations
   int step() const { return step_; }
   int resumed_from() const { return resumed_from_; }
+  // Adam's step size now: --Train.learning_rate, also after a resume (a checkpoint's own
+  // is replaced, so that a run can go on at a smaller one).
+  double learning_rate() const;
   FvsNet& net() { return net_; }
   const ModelConfig& config() const { return config_; }
   const torch::Device& device() const { return device_; }
