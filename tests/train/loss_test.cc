@@ -85,7 +85,8 @@ TEST(LpipsLoss, ZeroForEqualImagesAndFallsAlongItsGradient) {
   EXPECT_EQ(both.SecondTermName(), "1-ssim+lpips");
   EXPECT_EQ(both(target, target).second, 0.0);
   EXPECT_NEAR(both(other, target).second,
-              loss(other, target).second + 1.0 - Ssim(other, target).item<double>(), 1e-5);
+              loss(other, target).second + 1.0 - Ssim(other, target).item<double>(),
+              1e-5);
 }
 
 TEST(LpipsLoss, AutoPrefersVgg19ThenLpipsThenSsim) {
@@ -104,6 +105,34 @@ TEST(LpipsLoss, AutoPrefersVgg19ThenLpipsThenSsim) {
   LossOptions no_network;
   no_network.kind = "l1+lpips";
   EXPECT_THROW(TrainingLoss(no_network, torch::kCPU), Error);
+}
+
+// The choice term is the weights' expectation of each source's own error over the seen
+// pixels: the closest source alone scores its error, an even split the mean of the two,
+// unseen pixels do not count, and its gradient moves weight towards the closest source.
+TEST(ChoiceLoss, ExpectsEachSourcesErrorAndPullsWeightToTheClosest) {
+  const torch::Tensor target = torch::full({1, 3, 4, 4}, 0.5);
+  // Source 0 is off by 0.1 and source 1 by 0.3 (in [0, 1]); colours in [-1, 1].
+  const torch::Tensor rgb = torch::cat({torch::full({1, 3, 4, 4}, 2 * 0.6 - 1.0),
+                                        torch::full({1, 3, 4, 4}, 2 * 0.2 - 1.0)});
+  torch::Tensor seen = torch::ones({1, 1, 4, 4});
+  const torch::Tensor first =
+      torch::cat({torch::ones({1, 1, 4, 4}), torch::zeros({1, 1, 4, 4})});
+  EXPECT_NEAR(ChoiceLoss(first, rgb, target, seen).item<double>(), 0.1, 1e-6);
+  EXPECT_NEAR(ChoiceLoss(1.0 - first, rgb, target, seen).item<double>(), 0.3, 1e-6);
+  const torch::Tensor even = torch::full({2, 1, 4, 4}, 0.5);
+  EXPECT_NEAR(ChoiceLoss(even, rgb, target, seen).item<double>(), 0.2, 1e-6);
+  // Half the pixels unseen, where source 1 would be perfect: they do not count.
+  seen.narrow(3, 0, 2).zero_();
+  torch::Tensor rgb2 = rgb.clone();
+  rgb2[1].narrow(2, 0, 2) = 0.0;  // 0.5 in [0, 1]: exact, but unseen
+  EXPECT_NEAR(ChoiceLoss(1.0 - first, rgb2, target, seen).item<double>(), 0.3, 1e-6);
+  // Gradient through a softmax: the logit of the closer source rises.
+  const torch::Tensor logits = torch::zeros({2, 1, 4, 4}, torch::requires_grad());
+  ChoiceLoss(torch::softmax(logits, 0), rgb, target, torch::ones({1, 1, 4, 4}))
+      .backward();
+  EXPECT_LT(logits.grad()[0].sum().item<double>(), 0);
+  EXPECT_GT(logits.grad()[1].sum().item<double>(), 0);
 }
 
 }  // namespace

@@ -198,6 +198,16 @@ torch::Tensor TrainingLoss::SecondTerm(const torch::Tensor& prediction01,
   return 1.0 - Ssim(prediction01, target01);
 }
 
+torch::Tensor ChoiceLoss(const torch::Tensor& weights,
+                         const torch::Tensor& per_source_rgb,
+                         const torch::Tensor& target01, const torch::Tensor& seen) {
+  const torch::Tensor error =
+      ((per_source_rgb.to(torch::kFloat32) + 1.0) * 0.5 - target01).abs().mean(1, true);
+  const torch::Tensor expected = (weights.to(torch::kFloat32) * error).sum(0, true);
+  const torch::Tensor mask = (seen > 0).to(torch::kFloat32);
+  return (expected * mask).sum() / mask.sum().clamp_min(1.0);
+}
+
 LossValue TrainingLoss::operator()(const torch::Tensor& prediction01,
                                    const torch::Tensor& target01) {
   LossValue out;

@@ -40,10 +40,24 @@ class Vgg19FeaturesImpl : public torch::nn::Module {
 TORCH_MODULE(Vgg19Features);
 
 struct LossValue {
-  torch::Tensor total;  // differentiable scalar: l1 + second
+  torch::Tensor total;  // differentiable scalar: l1 + second (+ choice, the trainer's)
   double l1 = 0;
   double second = 0;  // 1 - SSIM, w x LPIPS, both, or the VGG19 term
+  double choice = 0;  // w x ChoiceLoss, when the trainer adds it
 };
+
+// The choice term of a soft-argmax blend: the mean over `seen` pixels of the blend
+// weights' expectation of each source's own error, sum_k w_k mean_c |c_k - y|, with
+// per-source colours c_k in [-1, 1] ([K,3,H,W]; scaled to [0, 1] here), weights [K,1,H,W]
+// and the target y [1,3,H,W] in [0, 1]; seen [1,1,H,W] (> 0 = counted). Why beside the
+// image loss: the image loss of a blend cannot tell a sharp choice of the right source
+// from an average that happens to land near the photo, and under noise it prefers the
+// average; this term is lowest when the weight sits on the source closest to the photo
+// and is the same for any weighting of sources that are equally right (noise), so it
+// teaches the choice without undoing the average where nothing tells sources apart.
+torch::Tensor ChoiceLoss(const torch::Tensor& weights,
+                         const torch::Tensor& per_source_rgb,
+                         const torch::Tensor& target01, const torch::Tensor& seen);
 
 // The loss of a run: `requested` (auto, l1+ssim, l1+lpips, l1+vgg19) made concrete.
 // auto: l1+vgg19 when a VGG19 file is given (asking for it is the stronger wish), else
@@ -56,8 +70,8 @@ bool LossUsesLpips(const std::string& kind);
 struct LossOptions {
   // l1+ssim, l1+lpips, l1+ssim+lpips or l1+vgg19 (ChooseLoss)
   std::string kind = "l1+ssim";
-  std::string vgg19_path;        // l1+vgg19: the weights file
-  LpipsNet lpips{nullptr};       // l1+lpips: the loaded network (validation shares it)
+  std::string vgg19_path;   // l1+vgg19: the weights file
+  LpipsNet lpips{nullptr};  // l1+lpips: the loaded network (validation shares it)
   double lpips_weight = 1.0;
 };
 

@@ -49,6 +49,7 @@ void TrainOptions::Check() const {
   Require(loss != "l1+vgg19" || !vgg19_path.empty(), kSubject,
           "--Train.loss l1+vgg19 needs --vgg19_path");
   Require(lpips_weight > 0, kSubject, "--Train.lpips_weight must be positive");
+  Require(choice_weight >= 0, kSubject, "--Train.choice_weight must not be negative");
   Require(precision == "fp32" || precision == "bf16", kSubject,
           "--Train.precision must be fp32 or bf16, not '" + precision +
               "' (fp16 training would need loss scaling)");
@@ -121,6 +122,9 @@ void AddTrainOptions(OptionManager* options, TrainOptions* o) {
       "l1+ssim), l1+ssim, l1+lpips, l1+ssim+lpips or l1+vgg19");
   options->AddDefault("Train.lpips_weight", &o->lpips_weight,
                       "weight of the LPIPS term of l1+lpips and l1+ssim+lpips");
+  options->AddDefault("Train.choice_weight", &o->choice_weight,
+                      "weight of the choice term (the blend weights' expected "
+                      "per-source error; soft-argmax networks; 0 = off)");
   options->AddDefault("Train.variant", &o->variant, "network variant");
   options->AddDefault(
       "Train.init_weights", &o->init_weights,

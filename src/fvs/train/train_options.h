@@ -24,6 +24,9 @@ struct TrainOptions {
   // auto | l1+ssim | l1+lpips | l1+vgg19 (ChooseLoss in train/loss.h).
   std::string loss = "auto";
   double lpips_weight = 1.0;  // of the LPIPS term of l1+lpips
+  // > 0: adds this times ChoiceLoss (train/loss.h) for soft-argmax networks: the blend
+  // weights' expected per-source error, which teaches the per-pixel choice of a source.
+  double choice_weight = 0;
   std::string variant = "fvs";
   // Start from these weights (their own variant and layout) instead of a fresh network;
   // a checkpoint in M still wins (resume). Fine-tuning (train/finetune.h) uses it.

@@ -303,17 +303,27 @@ LossValue Trainer::Step() {
     const torch::Tensor prediction01 =
         torch::where(seen, (out.rgb + 1.0) * 0.5, s.target);
     LossValue loss = (*loss_)(prediction01, s.target);
-    Require(std::isfinite(loss.l1) && std::isfinite(loss.second), "view_synthesis_train",
+    if (options_.choice_weight > 0 && out.weights.defined()) {
+      const torch::Tensor choice =
+          options_.choice_weight *
+          ChoiceLoss(out.weights, out.per_source_rgb, s.target, seen);
+      loss.total = loss.total + choice;
+      loss.choice = choice.item<double>();
+    }
+    Require(std::isfinite(loss.l1) && std::isfinite(loss.second) &&
+                std::isfinite(loss.choice),
+            "view_synthesis_train",
             "the loss became NaN or Inf at step " + std::to_string(step_ + 1) +
                 " (resume from the last checkpoint, perhaps with a lower learning rate)");
     (loss.total / b).backward();
     mean.l1 += loss.l1 / b;
     mean.second += loss.second / b;
+    mean.choice += loss.choice / b;
   }
   optimizer_->step();
   ++step_;
-  mean.total = torch::tensor(mean.l1 + mean.second);
-  last_loss_ = mean.l1 + mean.second;
+  mean.total = torch::tensor(mean.l1 + mean.second + mean.choice);
+  last_loss_ = mean.l1 + mean.second + mean.choice;
   return mean;
 }
 
@@ -399,6 +409,7 @@ std::string Trainer::SaveModel(const std::string& stem) {
   card["config"] = nlohmann::json::parse(config_.ToJson());
   card["loss"] = loss_->Name();
   if (LossUsesLpips(loss_->Name())) card["lpips_weight"] = options_.lpips_weight;
+  if (options_.choice_weight > 0) card["choice_weight"] = options_.choice_weight;
   if (!lpips_path_.empty()) card["lpips_weights"] = lpips_path_;
   card["steps"] = step_;
   card["batch_size"] = options_.batch_size;
@@ -452,7 +463,7 @@ TrainSummary Trainer::Run() {
   Timer total;
   StopSignals signals;
   Timer since_checkpoint, window;
-  double window_loss = 0, window_l1 = 0, window_second = 0;
+  double window_loss = 0, window_l1 = 0, window_second = 0, window_choice = 0;
   int window_steps = 0;
   const int first_step = step_;
   if (!options_.quiet) {
@@ -468,9 +479,10 @@ TrainSummary Trainer::Run() {
     Timer step_timer;
     const LossValue loss = Step();
     train_seconds_ += step_timer.Seconds();
-    window_loss += loss.l1 + loss.second;
+    window_loss += loss.l1 + loss.second + loss.choice;
     window_l1 += loss.l1;
     window_second += loss.second;
+    window_choice += loss.choice;
     ++window_steps;
     if (step_ % options_.log_every == 0 || step_ == options_.max_steps ||
         budget_spent()) {
@@ -483,11 +495,13 @@ TrainSummary Trainer::Run() {
         std::cerr << "[train] step " << step_ << "/" << options_.max_steps << "  loss "
                   << std::fixed << std::setprecision(4) << window_loss / window_steps
                   << " (l1 " << window_l1 / window_steps << ", "
-                  << loss_->SecondTermName() << " " << window_second / window_steps
-                  << ")  " << std::setprecision(2) << rate << " samples/s  ETA "
+                  << loss_->SecondTermName() << " " << window_second / window_steps;
+        if (options_.choice_weight > 0)
+          std::cerr << ", choice " << window_choice / window_steps;
+        std::cerr << ")  " << std::setprecision(2) << rate << " samples/s  ETA "
                   << FormatDuration(eta) << "\n";
       }
-      window_loss = window_l1 = window_second = 0;
+      window_loss = window_l1 = window_second = window_choice = 0;
       window_steps = 0;
       window.Restart();
     }
