@@ -9,9 +9,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "fvs/train/data.h"
+#include "fvs/train/headroom.h"
 #include "fvs/train/loss.h"
 #include "fvs/train/pack.h"
 #include "fvs/util/atomic_file.h"
@@ -105,6 +107,26 @@ TEST_F(TrainerTest, LossDecreasesOnAFixedSample) {
   train(kTinyNet, &skip_first, &skip_last);
   EXPECT_LT(skip_first, 0.5 * first) << skip_first << " vs " << first;
   EXPECT_LE(skip_last, skip_first * 1.05) << skip_first << " -> " << skip_last;
+}
+
+// The headroom rows: every method for the scene and for all, finite, the oracles that
+// see the photo no worse than `ulr` on this scene, and the per-pixel oracle no worse than
+// the per-block one (it may choose per pixel what the block oracle chooses per block).
+TEST_F(TrainerTest, HeadroomReportsUlrAndTheThreeOracles) {
+  const PackedScene scene = LoadPackedScene(dir_->path() + "/scene_a");
+  const auto rows = MeasureHeadroom({scene}, 2, 2, SampleWarpOptions{}, nullptr);
+  ASSERT_EQ(rows.size(), 8u);
+  std::map<std::string, double> psnr;
+  for (const HeadroomRow& r : rows) {
+    EXPECT_EQ(r.views, 2) << r.scene << " " << r.method;
+    EXPECT_TRUE(std::isfinite(r.psnr) && std::isfinite(r.ssim)) << r.method;
+    EXPECT_EQ(r.lpips, -1);
+    if (r.scene == "all") psnr[r.method] = r.psnr;
+  }
+  ASSERT_EQ(psnr.size(), 4u);
+  EXPECT_GE(psnr["oracle_pixel"], psnr["ulr"] - 1e-6);
+  EXPECT_GE(psnr["oracle_pixel"], psnr["oracle_patch8"] - 1e-6);
+  EXPECT_GE(psnr["oracle_global"], psnr["ulr"] - 0.05);
 }
 
 TEST_F(TrainerTest, SsimIsOneForEqualImagesAndLowerOtherwise) {

@@ -6,7 +6,11 @@
 // the mean squared error). Both oracles see the photo, so they bound what any blender of
 // these warps can reach: the per-pixel one shows the gain of a sharp per-pixel choice
 // (occlusion, misalignment), the global one how much a better choice of sources alone
-// gives. Pixels no source sees are filled as the renderer fills them, the same for all.
+// gives. The per-8x8-block oracle (one source per block, the one closest to the photo
+// over the block) is a choice that cannot follow the noise pixel by pixel: the per-pixel
+// oracle also wins by picking, among equally right sources, the one whose noise lands
+// nearest the photo, which no blender can predict. Pixels no source sees are filled as
+// the renderer fills them, the same for all.
 #pragma once
 
 #include <torch/torch.h>
@@ -21,7 +25,7 @@ namespace fvs {
 
 struct HeadroomRow {
   std::string scene;
-  std::string method;  // ulr | oracle_pixel | oracle_global
+  std::string method;  // ulr | oracle_pixel | oracle_global | oracle_patch8
   int views = 0;
   double psnr = 0, ssim = 0;
   double lpips = -1;  // -1: no LPIPS function given
