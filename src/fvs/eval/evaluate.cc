@@ -26,12 +26,9 @@ std::string FormatScale(double scale) {
   return text;
 }
 
-// Image names may hold '/': flatten them for file names.
+// The flat name without its extension (the contact sheet's PNGs).
 std::string FileStem(const std::string& name) {
-  std::string stem = name;
-  for (char& c : stem) {
-    if (c == '/' || c == '\\' || c == ' ') c = '_';
-  }
+  const std::string stem = FlatImageName(name);
   const size_t dot = stem.rfind('.');
   return dot == std::string::npos || dot == 0 ? stem : stem.substr(0, dot);
 }
@@ -221,6 +218,14 @@ std::vector<PlannedView> PlanViews(const Scene& scene, const TargetSet& set,
 }
 
 }  // namespace
+
+std::string FlatImageName(const std::string& name) {
+  std::string flat = name;
+  for (char& c : flat) {
+    if (c == '/' || c == '\\' || c == ' ') c = '_';
+  }
+  return flat;
+}
 
 std::vector<ViewResult> EvaluateTargets(
     const Scene& scene, const TargetSet& set, const std::vector<EvalTarget>& targets,

@@ -83,7 +83,33 @@ struct ViewResult {
 
   bool ok() const { return error.empty(); }
   bool failed() const { return !ok() && !skipped; }
+
+  // The measured fields above, psnr to height, in results.csv's column order, each with
+  // the decimals the CSV keeps (0 for the ints): results.csv (report.cc) and the view
+  // journal (view_journal.cc) write and read them through this list, so a new number is
+  // its declaration plus one line here. (Self: ViewResult or const ViewResult; visit
+  // takes (name, double& or int&, decimals).)
+  template <typename Self, typename Visit>
+  static void ForEachMeasure(Self& r, Visit&& visit) {
+    visit("psnr", r.psnr, 4);
+    visit("ssim", r.ssim, 5);
+    visit("lpips", r.lpips, 5);
+    visit("psnr_covered", r.psnr_covered, 4);
+    visit("ssim_covered", r.ssim_covered, 5);
+    visit("seconds", r.seconds, 4);
+    visit("cpu_seconds", r.cpu_seconds, 4);
+    visit("sources_used", r.sources_used, 0);
+    visit("coverage", r.coverage, 4);
+    visit("mesh_pixels", r.mesh_pixels, 4);
+    visit("infinity_pixels", r.infinity_pixels, 4);
+    visit("filled_pixels", r.filled_pixels, 4);
+    visit("width", r.width, 0);
+    visit("height", r.height, 0);
+  }
 };
+
+// An image name (which may hold '/', '\\' and spaces) as one file name: those become '_'.
+std::string FlatImageName(const std::string& name);
 
 // Thumbnails for the contact sheet (rendered beside the photo).
 struct ViewThumbnails {

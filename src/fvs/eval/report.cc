@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <map>
 #include <sstream>
+#include <type_traits>
 
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
@@ -11,13 +12,19 @@
 namespace fvs::eval {
 namespace {
 
-const std::vector<std::string> kColumns = {
-    "scene",         "method",       "num_sources", "scale",
-    "precision",     "protocol",     "target",      "geometry_holdout",
-    "status",        "psnr",         "ssim",        "lpips",
-    "psnr_covered",  "ssim_covered", "seconds",     "cpu_seconds",
-    "sources_used",  "coverage",     "mesh_pixels", "infinity_pixels",
-    "filled_pixels", "width",        "height",      "error"};
+// The identity columns, ViewResult::ForEachMeasure's, then the error message.
+std::vector<std::string> Columns() {
+  std::vector<std::string> columns = {"scene",  "method",           "num_sources",
+                                      "scale",  "precision",        "protocol",
+                                      "target", "geometry_holdout", "status"};
+  const ViewResult names;
+  ViewResult::ForEachMeasure(
+      names, [&](const char* name, const auto&, int) { columns.push_back(name); });
+  columns.push_back("error");
+  return columns;
+}
+const std::vector<std::string> kColumns = Columns();
+constexpr size_t kFirstMeasureColumn = 9;
 // Where the pixel-origin columns start; files written before them lack the three.
 constexpr size_t kFirstOriginColumn = 18;
 constexpr size_t kNumOriginColumns = 3;
@@ -186,14 +193,16 @@ void WriteResultsCsv(const std::string& path, const std::vector<ViewResult>& res
           << CsvField(r.target) << "," << (r.geometry_holdout ? "yes" : "no") << ","
           << (r.ok()      ? "ok"
               : r.skipped ? "skipped"
-                          : "error")
-          << "," << FormatNumber(r.psnr, 4) << "," << FormatNumber(r.ssim, 5) << ","
-          << FormatNumber(r.lpips, 5) << "," << FormatNumber(r.psnr_covered, 4) << ","
-          << FormatNumber(r.ssim_covered, 5) << "," << FormatNumber(r.seconds, 4) << ","
-          << FormatNumber(r.cpu_seconds, 4) << "," << r.sources_used << ","
-          << FormatNumber(r.coverage, 4) << "," << FormatNumber(r.mesh_pixels, 4) << ","
-          << FormatNumber(r.infinity_pixels, 4) << "," << FormatNumber(r.filled_pixels, 4)
-          << "," << r.width << "," << r.height << "," << CsvField(r.error) << "\n";
+                          : "error");
+      ViewResult::ForEachMeasure(r, [&](const char*, const auto& value, int decimals) {
+        out << ",";
+        if constexpr (std::is_same_v<std::decay_t<decltype(value)>, int>) {
+          out << value;
+        } else {
+          out << FormatNumber(value, decimals);
+        }
+      });
+      out << "," << CsvField(r.error) << "\n";
     }
   });
 }
@@ -231,21 +240,15 @@ std::vector<ViewResult> ReadResultsCsv(const std::string& path) {
     r.skipped = fields[8] == "skipped";
     Require(ok || r.skipped || fields[8] == "error", where,
             "status must be ok, skipped or error");
-    r.psnr = ParseNumber(fields[9], where);
-    r.ssim = ParseNumber(fields[10], where);
-    r.lpips = ParseNumber(fields[11], where);
-    r.psnr_covered = ParseNumber(fields[12], where);
-    r.ssim_covered = ParseNumber(fields[13], where);
-    r.seconds = ParseNumber(fields[14], where);
-    r.cpu_seconds = ParseNumber(fields[15], where);
-    r.sources_used = ParseInt(fields[16], where);
-    r.coverage = ParseNumber(fields[17], where);
-    r.mesh_pixels = ParseNumber(fields[18], where);
-    r.infinity_pixels = ParseNumber(fields[19], where);
-    r.filled_pixels = ParseNumber(fields[20], where);
-    r.width = ParseInt(fields[21], where);
-    r.height = ParseInt(fields[22], where);
-    r.error = fields[23];
+    size_t column = kFirstMeasureColumn;
+    ViewResult::ForEachMeasure(r, [&](const char*, auto& value, int) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(value)>, int>) {
+        value = ParseInt(fields[column++], where);
+      } else {
+        value = ParseNumber(fields[column++], where);
+      }
+    });
+    r.error = fields.back();
     if (ok) {
       Require(r.error.empty(), where, "status ok with an error message");
       Require(std::isfinite(r.psnr) && std::isfinite(r.ssim) && std::isfinite(r.seconds),

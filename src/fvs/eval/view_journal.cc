@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <type_traits>
 
 #include "colmap_ext/image_io.h"
 #include "fvs/util/atomic_file.h"
@@ -24,30 +25,25 @@ double NumberOf(const json& j, const char* key) {
   return value.is_null() ? kNotAvailable : value.get<double>();
 }
 
+// The identity of a view, then ViewResult::ForEachMeasure's fields.
 json ToJson(const ViewResult& r) {
-  return {{"scene", r.scene},
-          {"method", r.config.method},
-          {"num_sources", r.config.num_sources},
-          {"scale", r.config.scale},
-          {"precision", r.config.precision},
-          {"model_path", r.config.model_path},
-          {"protocol", r.protocol},
-          {"target", r.target},
-          {"geometry_holdout", r.geometry_holdout},
-          {"psnr", Number(r.psnr)},
-          {"ssim", Number(r.ssim)},
-          {"lpips", Number(r.lpips)},
-          {"psnr_covered", Number(r.psnr_covered)},
-          {"ssim_covered", Number(r.ssim_covered)},
-          {"seconds", Number(r.seconds)},
-          {"cpu_seconds", Number(r.cpu_seconds)},
-          {"sources_used", r.sources_used},
-          {"coverage", Number(r.coverage)},
-          {"mesh_pixels", Number(r.mesh_pixels)},
-          {"infinity_pixels", Number(r.infinity_pixels)},
-          {"filled_pixels", Number(r.filled_pixels)},
-          {"width", r.width},
-          {"height", r.height}};
+  json j = {{"scene", r.scene},
+            {"method", r.config.method},
+            {"num_sources", r.config.num_sources},
+            {"scale", r.config.scale},
+            {"precision", r.config.precision},
+            {"model_path", r.config.model_path},
+            {"protocol", r.protocol},
+            {"target", r.target},
+            {"geometry_holdout", r.geometry_holdout}};
+  ViewResult::ForEachMeasure(r, [&](const char* name, const auto& value, int) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(value)>, int>) {
+      j[name] = value;
+    } else {
+      j[name] = Number(value);
+    }
+  });
+  return j;
 }
 
 ViewResult FromJson(const json& j) {
@@ -61,30 +57,14 @@ ViewResult FromJson(const json& j) {
   r.protocol = j.at("protocol").get<std::string>();
   r.target = j.at("target").get<std::string>();
   r.geometry_holdout = j.at("geometry_holdout").get<bool>();
-  r.psnr = NumberOf(j, "psnr");
-  r.ssim = NumberOf(j, "ssim");
-  r.lpips = NumberOf(j, "lpips");
-  r.psnr_covered = NumberOf(j, "psnr_covered");
-  r.ssim_covered = NumberOf(j, "ssim_covered");
-  r.seconds = NumberOf(j, "seconds");
-  r.cpu_seconds = NumberOf(j, "cpu_seconds");
-  r.sources_used = j.at("sources_used").get<int>();
-  r.coverage = NumberOf(j, "coverage");
-  r.mesh_pixels = NumberOf(j, "mesh_pixels");
-  r.infinity_pixels = NumberOf(j, "infinity_pixels");
-  r.filled_pixels = NumberOf(j, "filled_pixels");
-  r.width = j.at("width").get<int>();
-  r.height = j.at("height").get<int>();
+  ViewResult::ForEachMeasure(r, [&](const char* name, auto& value, int) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(value)>, int>) {
+      value = j.at(name).get<int>();
+    } else {
+      value = NumberOf(j, name);
+    }
+  });
   return r;
-}
-
-// Image names may hold '/' and spaces; the target's own name inside the entry decides.
-std::string FlatName(const std::string& name) {
-  std::string flat = name;
-  for (char& c : flat) {
-    if (c == '/' || c == '\\' || c == ' ') c = '_';
-  }
-  return flat;
 }
 
 }  // namespace
@@ -101,17 +81,19 @@ ViewJournal::ViewJournal(const std::string& dir, const std::string& settings,
     } catch (const Error&) {
     }
   }
-  if (discard || previous != settings) fs::remove_all(dir, ec);
+  // Entries of other settings (or all, when asked) are never reused: start afresh.
+  const bool fresh = discard || previous != settings;
+  if (fresh) fs::remove_all(dir, ec);
   fs::create_directories(dir, ec);
   Require(!ec, dir, "cannot create the evaluation journal folder: " + ec.message());
-  if (discard || previous != settings) {
+  if (fresh) {
     WriteFileAtomic(settings_path, [&](std::ostream& out) { out << settings; });
   }
 }
 
 std::string ViewJournal::EntryStem(const EvalConfig& config,
                                    const std::string& target) const {
-  return (fs::path(dir_) / config.Slug() / FlatName(target)).string();
+  return (fs::path(dir_) / config.Slug() / FlatImageName(target)).string();
 }
 
 bool ViewJournal::Find(const EvalConfig& config, const std::string& target,
