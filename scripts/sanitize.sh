@@ -11,7 +11,10 @@ cd "$(dirname "$0")/.."
 export FVS_BUILD_DIR="${FVS_SANITIZE_BUILD_DIR:-build-asan}"
 # RelWithDebInfo: reports with file:line; -O2 keeps the suite's run time bearable.
 scripts/build.sh -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFVS_SANITIZE=ON
-export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:abort_on_error=0:detect_stack_use_after_return=0}"
+# fast_unwind_on_malloc=0: the frame-pointer unwinder stops in libraries built without
+# frame pointers (libpng under OpenImageIO), so a leak there showed no OpenImageIO frame
+# and tests/lsan.supp could not match it; the full unwinder sees the whole stack.
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:abort_on_error=0:detect_stack_use_after_return=0:fast_unwind_on_malloc=0}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
 cd "$FVS_BUILD_DIR"
 start=$(date +%s)
