@@ -1,9 +1,10 @@
 // `cmake --install` as a user runs it (doc/install.md): the tree under a temporary prefix
 // works on its own. The installed front door, run from another folder with no source or
-// build path in its environment (and, where a private mount namespace can be made, with the
-// source tree hidden under an empty tmpfs), generates a scene, renders it with ulr, finds
-// the real COLMAP, and finds weights in <prefix>/share/colmap-fvs/models or $FVS_MODEL_DIR.
-// Needs the colmap and fvs_train_main targets built (ctest builds them first).
+// build path in its environment (and, where a private mount namespace can be made, with
+// the source tree hidden under an empty tmpfs), generates a scene, renders it with ulr,
+// finds the real COLMAP, and finds weights in <prefix>/share/colmap-fvs/models or
+// $FVS_MODEL_DIR. Needs the colmap and fvs_train_main targets built (ctest builds them
+// first).
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
@@ -29,17 +30,18 @@ bool CanHideSourceTree() {
   return can;
 }
 
-// Runs `command` in `cwd` with a plain environment: no FVS_* variables that point into the
-// checkout, PATH without build/bin. The source tree (with build/ inside it, and the build
-// tree wherever it is) is covered by an empty tmpfs in a private mount namespace when the
-// test may make one.
+// Runs `command` in `cwd` with a plain environment: no FVS_* variables that point into
+// the checkout, PATH without build/bin. The source tree (with build/ inside it, and the
+// build tree wherever it is) is covered by an empty tmpfs in a private mount namespace
+// when the test may make one.
 int RunInstalled(const std::string& cwd, const std::string& command, std::string* output,
                  const std::string& extra_env = "") {
   std::string hide;
   if (CanHideSourceTree()) {
     hide = "unshare -m sh -c 'mount -t tmpfs none " + std::string(FVS_SOURCE_DIR) +
            " && mount -t tmpfs none " + std::string(FVS_BINARY_DIR) + " 2>/dev/null; " +
-           "test ! -e " + std::string(FVS_SOURCE_DIR) + "/CMakeLists.txt && exec \"$@\"' sh ";
+           "test ! -e " + std::string(FVS_SOURCE_DIR) +
+           "/CMakeLists.txt && exec \"$@\"' sh ";
   }
   const std::string full =
       "cd " + Quote(cwd) +
@@ -98,16 +100,20 @@ TEST_F(InstallTest, LayoutHasBinariesModelsDocsAndManPage) {
   EXPECT_TRUE(fs::is_symlink(prefix_ + "/bin/colmap"));
   EXPECT_EQ(fs::read_symlink(prefix_ + "/bin/colmap").string(), "colmap-fvs");
   EXPECT_TRUE(fs::is_symlink(prefix_ + "/lib/colmap-fvs/bin/colmap"));
-  EXPECT_TRUE(fs::equivalent(prefix_ + "/lib/colmap-fvs/bin/colmap", prefix_ + "/bin/colmap-fvs"));
+  EXPECT_TRUE(fs::equivalent(prefix_ + "/lib/colmap-fvs/bin/colmap",
+                             prefix_ + "/bin/colmap-fvs"));
   // Every shipped weight file has its card beside it, installed together.
-  for (const auto& entry : fs::directory_iterator(std::string(FVS_SOURCE_DIR) + "/models")) {
+  for (const auto& entry :
+       fs::directory_iterator(std::string(FVS_SOURCE_DIR) + "/models")) {
     const std::string name = entry.path().filename().string();
     EXPECT_TRUE(fs::exists(prefix_ + "/share/colmap-fvs/models/" + name)) << name;
   }
 }
 
 // No RPATH/RUNPATH and no string in the installed binaries names the source or build tree
-// (such a path would be looked up at run time, or leak into messages).
+// (such a path would be looked up at run time, or leak into messages). Debug sections are
+// left out of the search: a RelWithDebInfo build (the sanitized suite's) records its
+// compilation folder there for debuggers, which nothing reads at run time.
 TEST_F(InstallTest, BinariesDoNotReferToTheSourceOrBuildTree) {
   for (const char* binary : {"bin/colmap-fvs", "bin/fvs_train_main"}) {
     const std::string path = prefix_ + "/" + binary;
@@ -115,9 +121,15 @@ TEST_F(InstallTest, BinariesDoNotReferToTheSourceOrBuildTree) {
     ASSERT_EQ(RunShell("readelf -d " + Quote(path), &dynamic), 0);
     EXPECT_EQ(dynamic.find("RPATH"), std::string::npos) << binary << "\n" << dynamic;
     EXPECT_EQ(dynamic.find("RUNPATH"), std::string::npos) << binary << "\n" << dynamic;
-    for (const std::string& tree : {std::string(FVS_SOURCE_DIR), std::string(FVS_BINARY_DIR)}) {
+    const std::string loaded = prefix_ + "/without-debug-sections";
+    ASSERT_EQ(
+        RunShell("strip --strip-debug -o " + Quote(loaded) + " " + Quote(path), nullptr),
+        0);
+    for (const std::string& tree :
+         {std::string(FVS_SOURCE_DIR), std::string(FVS_BINARY_DIR)}) {
       std::string hits;
-      RunShell("grep -a -o -F " + Quote(tree) + " " + Quote(path) + " | head -n 3", &hits);
+      RunShell("grep -a -o -F " + Quote(tree) + " " + Quote(loaded) + " | head -n 3",
+               &hits);
       EXPECT_EQ(hits, "") << binary << " names " << tree;
     }
   }
@@ -126,13 +138,14 @@ TEST_F(InstallTest, BinariesDoNotReferToTheSourceOrBuildTree) {
 TEST_F(InstallTest, InstalledFrontDoorGeneratesAndRendersAway) {
   TempDir work;
   std::string output;
-  ASSERT_EQ(RunInstalled(work.path(),
-                         prefix_ + "/bin/colmap view_synthesis_synthetic --output_path ws "
-                                   "--SyntheticScene.num_views 6 --SyntheticScene.width 96 "
-                                   "--SyntheticScene.height 72 "
-                                   "--SyntheticScene.write_proxy_mesh 1",
-                         &output),
-            0)
+  ASSERT_EQ(
+      RunInstalled(work.path(),
+                   prefix_ + "/bin/colmap view_synthesis_synthetic --output_path ws "
+                             "--SyntheticScene.num_views 6 --SyntheticScene.width 96 "
+                             "--SyntheticScene.height 72 "
+                             "--SyntheticScene.write_proxy_mesh 1",
+                   &output),
+      0)
       << output;
   ASSERT_TRUE(fs::exists(work / "ws/meshed-delaunay.ply")) << output;
   ASSERT_EQ(RunInstalled(work.path(),
@@ -154,7 +167,8 @@ TEST_F(InstallTest, InstalledFrontDoorGeneratesAndRendersAway) {
                                  "/bin/colmap view_synthesis --workspace_path ws "
                                  "--output_path agg --method fvs_agg --orbit 1";
   ASSERT_EQ(RunInstalled(work.path(), render_agg, &output), 0) << output;
-  EXPECT_NE(output.find("using the shipped model " + shipped), std::string::npos) << output;
+  EXPECT_NE(output.find("using the shipped model " + shipped), std::string::npos)
+      << output;
   // ... and $FVS_MODEL_DIR comes first.
   const std::string own = work / "own_models/fvs_agg.safetensors";
   SaveRandomModel(own, "fvs_agg");
@@ -166,9 +180,9 @@ TEST_F(InstallTest, InstalledFrontDoorGeneratesAndRendersAway) {
   fs::remove(shipped);
 }
 
-// The installed front door finds the real COLMAP by itself: with its own bin/ first on the
-// PATH (bin/colmap is the front door, marked), and as a user's unmarked `colmap` link to
-// bin/colmap-fvs (the Debian layout: /usr/bin holds Debian's colmap, no marker).
+// The installed front door finds the real COLMAP by itself: with its own bin/ first on
+// the PATH (bin/colmap is the front door, marked), and as a user's unmarked `colmap` link
+// to bin/colmap-fvs (the Debian layout: /usr/bin holds Debian's colmap, no marker).
 TEST_F(InstallTest, InstalledFrontDoorFindsTheRealColmap) {
   if (!fs::exists(RealColmapBinary())) GTEST_SKIP() << "no COLMAP installed";
   TempDir work;
@@ -176,14 +190,18 @@ TEST_F(InstallTest, InstalledFrontDoorFindsTheRealColmap) {
   fs::create_symlink(prefix_ + "/bin/colmap-fvs", work / "mine/colmap");
   const std::string real_dir = fs::path(RealColmapBinary()).parent_path().string();
   for (const std::string& run :
-       {"PATH=" + prefix_ + "/bin:" + real_dir + ":/usr/bin:/bin " + prefix_ + "/bin/colmap help",
+       {"PATH=" + prefix_ + "/bin:" + real_dir + ":/usr/bin:/bin " + prefix_ +
+            "/bin/colmap help",
         "PATH=" + work.path() + "/mine:" + real_dir + ":/usr/bin:/bin " + work.path() +
             "/mine/colmap help",
-        "PATH=" + prefix_ + "/lib/colmap-fvs/bin:" + real_dir + ":/usr/bin:/bin colmap help"}) {
+        "PATH=" + prefix_ + "/lib/colmap-fvs/bin:" + real_dir +
+            ":/usr/bin:/bin colmap help"}) {
     std::string output;
     EXPECT_EQ(RunInstalled(work.path(), run, &output), 0) << run << "\n" << output;
-    EXPECT_NE(output.find("feature_extractor"), std::string::npos) << run << "\n" << output;
-    EXPECT_NE(output.find("view_synthesis_prepare"), std::string::npos) << run << "\n" << output;
+    EXPECT_NE(output.find("feature_extractor"), std::string::npos) << run << "\n"
+                                                                   << output;
+    EXPECT_NE(output.find("view_synthesis_prepare"), std::string::npos) << run << "\n"
+                                                                        << output;
   }
 }
 
