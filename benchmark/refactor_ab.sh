@@ -33,13 +33,20 @@ seconds() {  # seconds LOG COMMAND...: runs it, appends its wall time to LOG
 "$B" view_synthesis_synthetic --output_path "$OUT/synthetic" \
   --SyntheticScene.num_views "$VIEWS" > /dev/null
 last=$(ls "$OUT/synthetic/images" | sort | tail -n 1)
-for side in a b; do
-  bin=$A extra=("${EXTRA_A[@]}")
-  [[ $side == b ]] && bin=$B extra=("${EXTRA_B[@]}")
-  seconds "$OUT/prepare_$side.txt" "$bin" view_synthesis_prepare \
-    --image_path "$OUT/synthetic/images" --workspace_path "$OUT/$side" \
-    --holdout_images "$last" --Stereo.max_image_size 400 "${extra[@]}"
-done
+# prepare_both TIMES_STEM WORKSPACE_PREFIX: view_synthesis_prepare with A into
+# OUT/<prefix>a, then with B into OUT/<prefix>b, each with its extra flags, timed.
+prepare_both() {
+  local side bin extra
+  for side in a b; do
+    bin=$A extra=("${EXTRA_A[@]}")
+    [[ $side == b ]] && bin=$B extra=("${EXTRA_B[@]}")
+    seconds "$OUT/$1_$side.txt" "$bin" view_synthesis_prepare \
+      --image_path "$OUT/synthetic/images" --workspace_path "$OUT/$2$side" \
+      --holdout_images "$last" --Stereo.max_image_size 400 "${extra[@]}"
+  done
+}
+
+prepare_both prepare ""
 
 # COLMAP's SfM differs from run to run of the same binary (threaded matching and mapping),
 # so the outputs are compared from one SfM: A's workspace with the stages after
@@ -59,13 +66,7 @@ for dst in sys.argv[2:]:
                 pass
     json.dump(manifest, open(dst + "/fvs/manifest.json", "w"), indent=2)
 PY
-for side in a b; do
-  bin=$A extra=("${EXTRA_A[@]}")
-  [[ $side == b ]] && bin=$B extra=("${EXTRA_B[@]}")
-  seconds "$OUT/stages_$side.txt" "$bin" view_synthesis_prepare \
-    --image_path "$OUT/synthetic/images" --workspace_path "$OUT/s$side" \
-    --holdout_images "$last" --Stereo.max_image_size 400 "${extra[@]}"
-done
+prepare_both stages s
 same=0 differ=0
 while IFS= read -r file; do
   case "$file" in *.log | */manifest.json) continue ;; esac
