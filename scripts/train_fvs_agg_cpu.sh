@@ -10,8 +10,9 @@
 # (it skips the held-out views, which are kept for the reported evaluation).
 # FVS_TRAIN_STEPS (default 200000), FVS_RUN (the run folder under runs/, default fvs_agg),
 # FVS_INIT (weights a new run starts from; a run with checkpoints resumes from them),
-# FVS_CHOICE (the weight of the choice term, train/loss.h; 0 = off), FVS_PACK_SCALE (0.5; the real scenes' pack size, 1 = the size view_synthesis_eval renders
-# them at; other scales pack into packed_s<scale>/) and FVS_PREPARE_ONLY=1 steer it.
+# FVS_CHOICE (the weight of the choice term, train/loss.h; 0 = off), FVS_PACK_SCALE (0.5;
+# the real scenes' pack size, 1 = the size view_synthesis_eval renders them at; other
+# scales pack into packed_s<scale>/) and FVS_PREPARE_ONLY=1 steer it.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 DATASETS="$(realpath "${1:-../shared/datasets}")"

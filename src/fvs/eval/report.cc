@@ -12,11 +12,13 @@
 namespace fvs::eval {
 namespace {
 
+// The columns that say which view and run a row is, before its measured fields.
+const std::vector<std::string> kIdentityColumns = {
+    "scene",    "method", "num_sources",      "scale", "precision",
+    "protocol", "target", "geometry_holdout", "status"};
 // The identity columns, ViewResult::ForEachMeasure's, then the error message.
 std::vector<std::string> Columns() {
-  std::vector<std::string> columns = {"scene",  "method",           "num_sources",
-                                      "scale",  "precision",        "protocol",
-                                      "target", "geometry_holdout", "status"};
+  std::vector<std::string> columns = kIdentityColumns;
   const ViewResult names;
   ViewResult::ForEachMeasure(
       names, [&](const char* name, const auto&, int) { columns.push_back(name); });
@@ -24,7 +26,7 @@ std::vector<std::string> Columns() {
   return columns;
 }
 const std::vector<std::string> kColumns = Columns();
-constexpr size_t kFirstMeasureColumn = 9;
+const size_t kFirstMeasureColumn = kIdentityColumns.size();
 // Where the pixel-origin columns start; files written before them lack the three.
 constexpr size_t kFirstOriginColumn = 18;
 constexpr size_t kNumOriginColumns = 3;

@@ -1,6 +1,7 @@
 #include "fvs/train/headroom.h"
 
 #include <cmath>
+#include <iterator>
 #include <sstream>
 
 #include "fvs/net/net.h"
@@ -75,8 +76,9 @@ std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
                                          int num_sources, int views_per_scene,
                                          const SampleWarpOptions& warp_settings,
                                          const ImageDistance& lpips) {
-  const char* kMethods[] = {"ulr", "oracle_pixel", "oracle_global", "oracle_patch8"};
-  constexpr int kNum = 4;
+  static constexpr const char* kMethods[] = {"ulr", "oracle_pixel", "oracle_global",
+                                             "oracle_patch8"};
+  constexpr int kNum = static_cast<int>(std::size(kMethods));
   std::vector<HeadroomRow> rows, all(kNum);
   const double no_lpips = lpips ? 0.0 : -1.0;
   for (int m = 0; m < kNum; ++m) all[m] = {"all", kMethods[m], 0, 0, 0, no_lpips};

@@ -44,6 +44,8 @@ struct LossValue {
   double l1 = 0;
   double second = 0;  // 1 - SSIM, w x LPIPS, both, or the VGG19 term
   double choice = 0;  // w x ChoiceLoss, when the trainer adds it
+  // The value of `total`, as a number (progress lines, the card's final loss).
+  double Value() const { return l1 + second + choice; }
 };
 
 // The choice term of a soft-argmax blend: the mean over `seen` pixels of the blend

@@ -322,8 +322,8 @@ LossValue Trainer::Step() {
   }
   optimizer_->step();
   ++step_;
-  mean.total = torch::tensor(mean.l1 + mean.second + mean.choice);
-  last_loss_ = mean.l1 + mean.second + mean.choice;
+  mean.total = torch::tensor(mean.Value());
+  last_loss_ = mean.Value();
   return mean;
 }
 
@@ -479,7 +479,7 @@ TrainSummary Trainer::Run() {
     Timer step_timer;
     const LossValue loss = Step();
     train_seconds_ += step_timer.Seconds();
-    window_loss += loss.l1 + loss.second + loss.choice;
+    window_loss += loss.Value();
     window_l1 += loss.l1;
     window_second += loss.second;
     window_choice += loss.choice;
