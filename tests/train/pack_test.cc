@@ -192,6 +192,34 @@ TEST_F(PackTest, SamplerIsLeaveOneOutAndReproducible) {
   EXPECT_THROW(c.SetState("not a state"), Error);
 }
 
+TEST_F(PackTest, HoldoutTargetsAreTheHeldOutViewsAndNeverSources) {
+  std::vector<PackedScene> scenes = {LoadPackedScene(dir_->path() + "/packed")};
+  PackedScene& p = scenes[0];
+  // No view held out: every view is a target either way.
+  for (int v = 0; v < 6; ++v) {
+    EXPECT_TRUE(IsTargetView(p, v, false));
+    EXPECT_TRUE(IsTargetView(p, v, true));
+  }
+  p.holdout[1] = p.holdout[4] = true;
+  EXPECT_EQ(ValidationTargets(p, 10, true), (std::vector<int>{1, 4}));
+  EXPECT_EQ(ValidationTargets(p, 10, false), (std::vector<int>{0, 2, 3, 5}));
+  SamplerOptions options;
+  options.num_sources = 3;
+  options.crop = 24;
+  options.holdout_targets = true;
+  TrainingSampler sampler(&scenes, options, 3);
+  std::set<int> targets;
+  for (int i = 0; i < 30; ++i) {
+    const TrainingSample s = sampler.Next();
+    targets.insert(s.target);
+    for (int j : s.sources) EXPECT_FALSE(p.holdout[j]);
+  }
+  EXPECT_EQ(targets, (std::set<int>{1, 4}));
+  options.holdout_targets = false;
+  TrainingSampler in_geometry(&scenes, options, 3);
+  for (int i = 0; i < 30; ++i) EXPECT_FALSE(p.holdout[in_geometry.Next().target]);
+}
+
 TEST_F(PackTest, CroppedSourcesSampleExactlyWhatTheFullSourcesDo) {
   std::vector<PackedScene> scenes = {LoadPackedScene(dir_->path() + "/packed")};
   SamplerOptions full_options;

@@ -112,10 +112,20 @@ std::vector<int> SelectTrainingSources(const PackedScene& scene, int target, int
   return order;
 }
 
-std::vector<int> ValidationTargets(const PackedScene& scene, int count) {
+bool PackedScene::HoldsViewsOut() const {
+  return std::find(holdout.begin(), holdout.end(), true) != holdout.end();
+}
+
+bool IsTargetView(const PackedScene& scene, int view, bool holdout_targets) {
+  if (holdout_targets && scene.HoldsViewsOut()) return scene.holdout[view];
+  return !scene.holdout[view];
+}
+
+std::vector<int> ValidationTargets(const PackedScene& scene, int count,
+                                   bool holdout_targets) {
   std::vector<int> candidates;
   for (int v = 0; v < scene.num_views(); ++v) {
-    if (!scene.holdout[v]) candidates.push_back(v);
+    if (IsTargetView(scene, v, holdout_targets)) candidates.push_back(v);
   }
   const int n = static_cast<int>(candidates.size());
   count = std::min(n, count);
@@ -375,7 +385,7 @@ TrainingSampler::TrainingSampler(const std::vector<PackedScene>* scenes,
     : scenes_(scenes), options_(options), rng_(seed) {
   for (size_t s = 0; s < scenes->size(); ++s) {
     for (int v = 0; v < (*scenes)[s].num_views(); ++v) {
-      if (!(*scenes)[s].holdout[v] &&
+      if (IsTargetView((*scenes)[s], v, options.holdout_targets) &&
           !SelectTrainingSources((*scenes)[s], v, 1).empty()) {
         targets_.emplace_back(static_cast<int>(s), v);
       }

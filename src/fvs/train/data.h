@@ -26,8 +26,9 @@ struct PackedScene {
   torch::Tensor K, R, t;  // double [N,3,3], [N,3,3], [N,3]
   torch::Tensor overlap;  // float [N,N], diagonal 0
   // Views held out of the geometry at prepare (the pack's "holdout" metadata): never a
-  // training or validation target, never a source.
+  // source; a target only where IsTargetView says so.
   std::vector<bool> holdout;
+  bool HoldsViewsOut() const;
 
   int num_views() const { return static_cast<int>(names.size()); }
   int height() const { return static_cast<int>(images.size(2)); }
@@ -42,9 +43,17 @@ PackedScene LoadPackedScene(const std::string& folder);
 // ties by index; never the target itself nor a held-out view.
 std::vector<int> SelectTrainingSources(const PackedScene& scene, int target, int k);
 
-// The validation targets of a scene: `count` views evenly spaced over those not held
-// out (fewer when the scene has fewer).
-std::vector<int> ValidationTargets(const PackedScene& scene, int count);
+// Whether `view` may be a training or validation target. By default the views in the
+// geometry (the held-out ones are kept for the reported evaluation). With
+// `holdout_targets`, a scene that holds views out offers only those: like any novel view,
+// no depth map of its own built the mesh they are rendered with. A scene holding none
+// out offers all its views either way.
+bool IsTargetView(const PackedScene& scene, int view, bool holdout_targets);
+
+// The validation targets of a scene: `count` views evenly spaced over its target views
+// (IsTargetView; fewer when the scene has fewer).
+std::vector<int> ValidationTargets(const PackedScene& scene, int count,
+                                   bool holdout_targets = false);
 
 // How a training sample is warped: the renderer's warp (geometry/warp.h) and, for the
 // prior and the baseline, the ULR log-weights.
@@ -130,13 +139,14 @@ struct SamplerOptions {
   // >= 0: CropSourcesToFootprint with this margin (the trainer's default, 16); < 0: full
   // sources.
   int source_margin = -1;
+  bool holdout_targets = false;  // IsTargetView
   SampleWarpOptions warp;
 };
 
-// Random leave-one-out samples: a target uniformly over all views of all scenes that have
-// a source, a uniform crop, jitter when augment. Everything random comes from one
-// std::mt19937_64 whose state State() / SetState() carry through a checkpoint, so a
-// resumed run draws exactly the samples an uninterrupted run would.
+// Random leave-one-out samples: a target uniformly over the target views (IsTargetView)
+// of all scenes that have a source, a uniform crop, jitter when augment. Everything
+// random comes from one std::mt19937_64 whose state State() / SetState() carry through a
+// checkpoint, so a resumed run draws exactly the samples an uninterrupted run would.
 class TrainingSampler {
  public:
   TrainingSampler(const std::vector<PackedScene>* scenes, const SamplerOptions& options,

@@ -75,7 +75,8 @@ torch::Tensor PatchOracle(const torch::Tensor& colours, const torch::Tensor& see
 std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
                                          int num_sources, int views_per_scene,
                                          const SampleWarpOptions& warp_settings,
-                                         const ImageDistance& lpips) {
+                                         const ImageDistance& lpips,
+                                         bool holdout_targets) {
   static constexpr const char* kMethods[] = {"ulr", "oracle_pixel", "oracle_global",
                                              "oracle_patch8"};
   constexpr int kNum = static_cast<int>(std::size(kMethods));
@@ -87,7 +88,7 @@ std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
   for (const PackedScene& scene : scenes) {
     std::vector<HeadroomRow> mine(kNum);
     for (int m = 0; m < kNum; ++m) mine[m] = {scene.path, kMethods[m], 0, 0, 0, no_lpips};
-    for (const int target : ValidationTargets(scene, views_per_scene)) {
+    for (const int target : ValidationTargets(scene, views_per_scene, holdout_targets)) {
       const auto sources = SelectTrainingSources(scene, target, num_sources);
       if (sources.empty()) continue;
       const TrainingSample s = MakeSample(scene, target, sources, 0, 0, scene.width(),

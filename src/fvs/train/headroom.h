@@ -34,13 +34,14 @@ struct HeadroomRow {
 // Distance of two [1,3,H,W] images in [0,1] (LPIPS); empty = not measured.
 using ImageDistance = std::function<double(const torch::Tensor&, const torch::Tensor&)>;
 
-// The validation views of Trainer::Validate (evenly spaced, held-out views skipped,
+// The validation views of Trainer::Validate (ValidationTargets with `holdout_targets`,
 // top-K sources by overlap, full packed size), one row per scene and method, then the
 // means over all views (scene "all").
 std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
                                          int num_sources, int views_per_scene,
                                          const SampleWarpOptions& warp,
-                                         const ImageDistance& lpips);
+                                         const ImageDistance& lpips,
+                                         bool holdout_targets = false);
 
 // Writes the rows as CSV (scene,method,views,psnr,ssim,lpips), atomically.
 void WriteHeadroomCsv(const std::string& path, const std::vector<HeadroomRow>& rows);

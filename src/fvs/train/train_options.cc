@@ -161,6 +161,9 @@ void AddTrainOptions(OptionManager* options, TrainOptions* o) {
                       "steps between validation passes (0: only at the end)");
   options->AddDefault("Train.val_views", &o->val_views,
                       "held-out views per validation scene");
+  options->AddDefault("Train.holdout_targets", &o->holdout_targets,
+                      "a scene that holds views out of its geometry trains and "
+                      "validates on those only (targets like novel views)");
   options->AddDefault("Train.seed", &o->seed, "seed of initialisation and sampling");
   options->AddDefault("Train.augment", &o->augment, "photometric augmentation");
   options->AddDefault("Train.fp16_weights", &o->fp16_weights,

@@ -53,6 +53,9 @@ struct TrainOptions {
   int log_every = 10;
   int val_every = 1000;  // 0: no periodic validation (still at the end with a list)
   int val_views = 4;     // held-out views per validation scene
+  // Train and validate on the views a scene holds out of its geometry (IsTargetView in
+  // train/data.h): targets like novel views, whose own depth never built the mesh.
+  bool holdout_targets = false;
   int seed = 0;
   bool augment = true;
   bool fp16_weights = false;

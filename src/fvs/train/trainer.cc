@@ -241,6 +241,7 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
   sampler.crop = options_.crop;
   sampler.augment = options_.augment;
   sampler.source_margin = options_.source_margin;
+  sampler.holdout_targets = options_.holdout_targets;
   sampler.warp = SampleWarpOptionsFor(config_, options_.occlusion_tolerance);
   // A seed of its own stream: the sampler must not share draws with LibTorch.
   sampler_ = std::make_unique<TrainingSampler>(
@@ -341,7 +342,8 @@ ValidationResult Trainer::Validate() {
     r.path = scene.path;
     double seconds = 0;
     // Held-out views (view_synthesis_eval's) are never validated on.
-    for (const int target : ValidationTargets(scene, options_.val_views)) {
+    for (const int target :
+         ValidationTargets(scene, options_.val_views, options_.holdout_targets)) {
       const auto sources = SelectTrainingSources(scene, target, options_.num_sources);
       if (sources.empty()) continue;
       // Always fp32 (whatever --Train.precision): figures comparable across runs.
@@ -561,9 +563,9 @@ TrainSummary RunHeadroom(const TrainOptions& options) {
       return lpips->forward(a, b).item<double>();
     };
   }
-  const std::vector<HeadroomRow> rows =
-      MeasureHeadroom(LoadScenes(options.val_scene_list, 2, options.num_sources),
-                      options.num_sources, options.val_views, warp, distance);
+  const std::vector<HeadroomRow> rows = MeasureHeadroom(
+      LoadScenes(options.val_scene_list, 2, options.num_sources), options.num_sources,
+      options.val_views, warp, distance, options.holdout_targets);
   std::filesystem::create_directories(options.output_path);
   WriteHeadroomCsv(options.output_path + "/headroom.csv", rows);
   for (const HeadroomRow& r : rows) {
