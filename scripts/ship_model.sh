@@ -29,11 +29,19 @@ SHIPPED="models/$VARIANT.safetensors"
 OUT="${FVS_SHIP_DIR:-/tmp/fvs_ship}"
 mkdir -p "$OUT"
 
+# What a workspace renders from: its mesh, cameras, holdout list and photos. Results are
+# kept under it, so a workspace re-meshed or re-prepared never reuses them.
+workspace_key() {
+  { cat "$1/meshed-delaunay.ply" "$1"/sparse/*.bin "$1/fvs/holdout.txt" 2>/dev/null
+    (cd "$1/images" && ls -l --time-style=+%s); } | sha256sum | cut -c1-12
+}
+
 # eval NAME WORKSPACE [view_synthesis_eval options]: OUT/<scene>/<NAME>/summary.csv
-# (reused when there: results are keyed by the weights' hash in NAME).
+# (reused when there: results are keyed by the workspace's content in <scene> and by the
+# weights' hash in NAME).
 evaluate() {
   local name=$1 ws=$2; shift 2
-  local dir="$OUT/$(basename "$ws")/$name"
+  local dir="$OUT/$(scene_dir "$ws")/$name"
   [[ -f "$dir/summary.csv" ]] && return 0
   # Weights are always named (--model_path), so a scene's fine-tuned ones never stand in.
   nice -n "${FVS_NICE:-0}" env OMP_WAIT_POLICY=PASSIVE "$COLMAP" view_synthesis_eval \
@@ -42,8 +50,15 @@ evaluate() {
 }
 
 hash_of() { sha256sum "$1" | cut -c1-16; }
+declare -A KEYS
+FOLDERS=()
 for ws in "${WORKSPACES[@]}"; do
-  mkdir -p "$OUT/$(basename "$ws")"
+  KEYS[$ws]="$(basename "$ws")-$(workspace_key "$ws")"
+  FOLDERS+=("${KEYS[$ws]}")
+done
+scene_dir() { echo "${KEYS[$1]}"; }
+for ws in "${WORKSPACES[@]}"; do
+  mkdir -p "$OUT/$(scene_dir "$ws")"
   evaluate ulr "$ws" --method ulr
   evaluate "candidate-$(hash_of "$CANDIDATE")" "$ws" --method "$VARIANT" --model_path "$CANDIDATE"
   if [[ -f "$SHIPPED" ]]; then
@@ -52,21 +67,21 @@ for ws in "${WORKSPACES[@]}"; do
 done
 
 python3 - "$OUT" "$CANDIDATE" "$CARD" "$SHIPPED" "$(hash_of "$CANDIDATE")" \
-  "$([[ -f "$SHIPPED" ]] && hash_of "$SHIPPED")" "${WORKSPACES[@]}" <<'EOF'
+  "$([[ -f "$SHIPPED" ]] && hash_of "$SHIPPED")" "${FOLDERS[@]}" <<'EOF'
 import csv, json, os, shutil, sys
 out, candidate, card_path, shipped, cand_hash, shipped_hash = sys.argv[1:7]
-workspaces = sys.argv[7:]
+keyed = sys.argv[7:]  # <scene>-<workspace key>: the folders of OUT
 
-def summary(scene, name):
-    with open(os.path.join(out, scene, name, "summary.csv")) as f:
+def summary(folder, name):
+    with open(os.path.join(out, folder, name, "summary.csv")) as f:
         row = next(csv.DictReader(f))
     return {k: float(row[k]) for k in ("psnr", "ssim", "lpips", "seconds_per_view", "views_ok")}
 
 rows, failures = [], []
-for ws in workspaces:
-    scene = os.path.basename(ws)
-    u, c = summary(scene, "ulr"), summary(scene, "candidate-" + cand_hash)
-    s = summary(scene, "shipped-" + shipped_hash) if shipped_hash else None
+for folder in keyed:
+    scene = folder.rsplit("-", 1)[0]
+    u, c = summary(folder, "ulr"), summary(folder, "candidate-" + cand_hash)
+    s = summary(folder, "shipped-" + shipped_hash) if shipped_hash else None
     rows.append((scene, u, c, s))
     if c["psnr"] < u["psnr"] + 0.5: failures.append(f"{scene}: PSNR {c['psnr']:.2f} < ulr {u['psnr']:.2f} + 0.5")
     if c["lpips"] > u["lpips"] - 0.02: failures.append(f"{scene}: LPIPS {c['lpips']:.4f} > ulr {u['lpips']:.4f} - 0.02")
