@@ -91,6 +91,21 @@ TEST(ModelConfigTest, VariantsAndJson) {
   EXPECT_THROW(ModelConfig::FromJson("{\"variant\": \"fvs\", \"blend_channels\": [8]}"),
                Error);
   EXPECT_THROW(ModelConfig::FromJson("{\"variant\": \"fvs\", \"use_gr\": false}"), Error);
+  // Numbers that are no int (get<int>() of them was undefined behaviour; the
+  // safetensors fuzzer found -1e30 in a weights file's fvs_config).
+  for (const char* bad : {"[17, 24, -1e30]", "[17, 24.5]", "[4294967297, 24]"}) {
+    EXPECT_THROW(ModelConfig::FromJson(std::string("{\"variant\": \"fvs_agg\", "
+                                                   "\"blend_channels\": ") +
+                                       bad + "}"),
+                 Error)
+        << bad;
+  }
+  EXPECT_THROW(ModelConfig::FromJson("{\"variant\": \"fvs\", \"ulr_num_blend\": 1e30}"),
+               Error);
+  EXPECT_EQ(
+      ModelConfig::FromJson("{\"variant\": \"fvs_agg\", \"blend_channels\": [16.0, 24]}")
+          .blend_channels,
+      (std::vector<int>{16, 24}));
   EXPECT_THROW(ModelConfig::FromJson("{\"variant\": \"fvs\", \"feature_channels\": -1}"),
                Error);
   const ModelConfig custom =
@@ -278,8 +293,8 @@ TEST(FvsAggTest, StartsAsTheUlrBlendAndLearnsEverywhere) {
   // Odd sizes on purpose: the padded pixels must not reach the gradients.
   for (int k : {1, 3}) ExpectFiniteGradients(net, MakeInputs(k, 16, 21, 20, 28));
   // Bad layouts are refused with a reason.
-  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_agg","encoder_channels":[8,16]})"),
-               Error);
+  EXPECT_THROW(
+      ModelConfig::FromJson(R"({"variant":"fvs_agg","encoder_channels":[8,16]})"), Error);
   EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_agg","ulr_prior":0})"), Error);
   EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_agg","blend_channels":[8]})"),
                Error);

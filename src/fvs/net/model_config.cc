@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "fvs/util/error.h"
+#include "fvs/util/json_number.h"
 
 namespace fvs {
 namespace {
@@ -26,6 +28,31 @@ void Read(const nlohmann::json& json, const char* key, T* value) {
     throw Error(kSubject, std::string("field \"") + key +
                               "\" has the wrong type: " + json.at(key).dump());
   }
+}
+
+// Whole numbers through JsonToInt: get<int>() of 1e30 is undefined behaviour (found by
+// safetensors_fuzzer in a weights file's fvs_config).
+void ReadWhole(const nlohmann::json& v, const char* key, int* out) {
+  if (!JsonToInt(v, std::numeric_limits<int>::min(), std::numeric_limits<int>::max(),
+                 out)) {
+    throw Error(kSubject,
+                std::string("field \"") + key + "\" is not a whole number: " + v.dump());
+  }
+}
+
+void Read(const nlohmann::json& json, const char* key, int* value) {
+  if (json.contains(key)) ReadWhole(json.at(key), key, value);
+}
+
+void Read(const nlohmann::json& json, const char* key, std::vector<int>* value) {
+  if (!json.contains(key)) return;
+  const nlohmann::json& list = json.at(key);
+  if (!list.is_array()) {
+    throw Error(kSubject,
+                std::string("field \"") + key + "\" is not a list: " + list.dump());
+  }
+  value->assign(list.size(), 0);
+  for (size_t i = 0; i < list.size(); ++i) ReadWhole(list[i], key, &(*value)[i]);
 }
 
 // Every variant once: its name and how it differs from the default (the paper's `fvs`).
