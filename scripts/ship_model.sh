@@ -36,12 +36,11 @@ workspace_key() {
     (cd "$1/images" && ls -l --time-style=+%s); } | sha256sum | cut -c1-12
 }
 
-# eval NAME WORKSPACE [view_synthesis_eval options]: OUT/<scene>/<NAME>/summary.csv
-# (reused when there: results are keyed by the workspace's content in <scene> and by the
+# eval NAME WORKSPACE FOLDER [view_synthesis_eval options]: OUT/FOLDER/NAME/summary.csv
+# (reused when there: results are keyed by the workspace's content in FOLDER and by the
 # weights' hash in NAME).
 evaluate() {
-  local name=$1 ws=$2; shift 2
-  local dir="$OUT/$(scene_dir "$ws")/$name"
+  local name=$1 ws=$2 dir="$OUT/$3/$1"; shift 3
   [[ -f "$dir/summary.csv" ]] && return 0
   # Weights are always named (--model_path), so a scene's fine-tuned ones never stand in.
   nice -n "${FVS_NICE:-0}" env OMP_WAIT_POLICY=PASSIVE "$COLMAP" view_synthesis_eval \
@@ -50,19 +49,17 @@ evaluate() {
 }
 
 hash_of() { sha256sum "$1" | cut -c1-16; }
-declare -A KEYS
-FOLDERS=()
+FOLDERS=()  # OUT/<scene>-<workspace key>, one per workspace
 for ws in "${WORKSPACES[@]}"; do
-  KEYS[$ws]="$(basename "$ws")-$(workspace_key "$ws")"
-  FOLDERS+=("${KEYS[$ws]}")
-done
-scene_dir() { echo "${KEYS[$1]}"; }
-for ws in "${WORKSPACES[@]}"; do
-  mkdir -p "$OUT/$(scene_dir "$ws")"
-  evaluate ulr "$ws" --method ulr
-  evaluate "candidate-$(hash_of "$CANDIDATE")" "$ws" --method "$VARIANT" --model_path "$CANDIDATE"
+  folder="$(basename "$ws")-$(workspace_key "$ws")"
+  FOLDERS+=("$folder")
+  mkdir -p "$OUT/$folder"
+  evaluate ulr "$ws" "$folder" --method ulr
+  evaluate "candidate-$(hash_of "$CANDIDATE")" "$ws" "$folder" --method "$VARIANT" \
+    --model_path "$CANDIDATE"
   if [[ -f "$SHIPPED" ]]; then
-    evaluate "shipped-$(hash_of "$SHIPPED")" "$ws" --method "$VARIANT" --model_path "$SHIPPED"
+    evaluate "shipped-$(hash_of "$SHIPPED")" "$ws" "$folder" --method "$VARIANT" \
+      --model_path "$SHIPPED"
   fi
 done
 

@@ -53,22 +53,18 @@ link_photos() {
 }
 
 # Prepares images/<scene> into <ws>/<scene> with every 5th photo from `offset` held out
-# of the geometry (offset -1: none). The other fold's workspace of the same photos lends
-# its SfM (database, model and the manifest, whose paths are relative), so only the dense
-# stages run again.
+# of the geometry. Another fold's workspace of the same photos lends its SfM (database,
+# model and the manifest, whose paths are relative), so only the dense stages run again.
 prepare_scene() {
   local scene=$1 offset=$2 wsroot=$3 ws=$3/$1 model=${4:-SIMPLE_RADIAL}
   [[ -f $ws/.done ]] && return 0
-  local j=0 held=() args=() donor=""
+  local j=0 held=() donor=""
   for f in $(ls images/$scene | sort); do
-    (( offset >= 0 && j % 5 == offset )) && held+=("$f")
+    (( j % 5 == offset )) && held+=("$f")
     j=$((j + 1))
   done
-  if (( offset >= 0 )); then
-    printf "%s\n" "${held[@]}" > images/$scene.holdout$offset.txt
-    args=(--holdout_images images/$scene.holdout$offset.txt)
-  fi
-  for d in ws_h0 ws_h1 ws_h2 ws_h3 ws_h4; do
+  printf "%s\n" "${held[@]}" > images/$scene.holdout$offset.txt
+  for d in ws_h[0-9]; do
     [[ $d != "$wsroot" && -f $d/$scene/.done && -d $d/$scene/sfm/0 ]] && donor=$d/$scene && break
   done
   if [[ -n $donor && ! -d $ws/sfm ]]; then
@@ -79,7 +75,8 @@ prepare_scene() {
   fi
   echo "prepare $ws ($(ls images/$scene | wc -l) photos, ${#held[@]} held out${donor:+, SfM of $donor})"
   FVS_QUIET=1 nice -n "$NICE" bin/colmap view_synthesis_prepare --image_path images/$scene \
-    --workspace_path $ws --max_image_size 800 --Stereo.max_image_size 400 "${args[@]}" \
+    --workspace_path $ws --max_image_size 800 --Stereo.max_image_size 400 \
+    --holdout_images images/$scene.holdout$offset.txt \
     --ImageReader.camera_model $model \
     > $ws.log 2>&1 && touch $ws/.done || echo "  failed: see $ws.log"
 }

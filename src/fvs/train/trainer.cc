@@ -341,7 +341,8 @@ ValidationResult Trainer::Validate() {
     ValidationResult::Scene r;
     r.path = scene.path;
     double seconds = 0;
-    // Held-out views (view_synthesis_eval's) are never validated on.
+    // By default the held-out views (view_synthesis_eval's) are never validated on;
+    // with --Train.holdout_targets only they are (IsTargetView).
     for (const int target :
          ValidationTargets(scene, options_.val_views, options_.holdout_targets)) {
       const auto sources = SelectTrainingSources(scene, target, options_.num_sources);
