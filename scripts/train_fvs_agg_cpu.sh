@@ -11,7 +11,8 @@
 # holdout reports their held-out views, scripts/ship_model.sh) and the selection scenes
 # (ethiopian_head, beer), whose held-out views the trainer validates and picks
 # checkpoints on, so that no reported view ever steers training.
-# FVS_TRAIN_STEPS (default 200000), FVS_RUN (the run folder under runs/, default
+# FVS_VARIANT (fvs_agg, or fvs_agg_rel: its choice sees colours only relative to the
+# blend), FVS_TRAIN_STEPS (default 200000), FVS_RUN (the run folder under runs/, default
 # fvs_agg_h), FVS_INIT (weights a new run starts from; a run with checkpoints resumes from
 # them), FVS_CHOICE (the weight of the choice term, train/loss.h; 0 = off), FVS_LOSS and
 # FVS_LPIPS_WEIGHT (l1+ssim+lpips and 1 with the LPIPS weights), FVS_LR
@@ -140,7 +141,7 @@ exec nice -n "$NICE" env FVS_NUM_THREADS="${FVS_NUM_THREADS:-$(nproc)}" \
   --scene_list train_h$SCALE.txt --val_scene_list val_h$SCALE.txt \
   --output_path "runs/${FVS_RUN:-fvs_agg_h}" --Train.holdout_targets 1 \
   ${FVS_INIT:+--Train.init_weights "$FVS_INIT"} \
-  --Train.variant fvs_agg --Train.crop 128 --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
+  --Train.variant "${FVS_VARIANT:-fvs_agg}" --Train.crop 128 --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
   --Train.batch_size 4 --Train.learning_rate "${FVS_LR:-2e-4}" --Train.val_every 250 \
   --Train.val_views 4 --Train.log_every 25 --Train.checkpoint_minutes 10 --Train.loss "$LOSS" \
   --Train.choice_weight "${FVS_CHOICE:-0}" --Train.lpips_weight "${FVS_LPIPS_WEIGHT:-1}"

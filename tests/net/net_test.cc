@@ -264,11 +264,16 @@ TEST(FvsNetTest, RgbSkipStartsAsThePriorBlendOfTheWarpedSources) {
                Error);
 }
 
-TEST(FvsAggTest, StartsAsTheUlrBlendAndLearnsEverywhere) {
+// The aggregate blender's variants: with and without relative_inputs.
+class FvsAggTest : public ::testing::TestWithParam<const char*> {};
+INSTANTIATE_TEST_SUITE_P(Variants, FvsAggTest,
+                         ::testing::Values("fvs_agg", "fvs_agg_rel"));
+
+TEST_P(FvsAggTest, StartsAsTheUlrBlendAndLearnsEverywhere) {
   // fvs_agg untrained: zero confidence and colour heads and a zero residual, so it
   // renders the ULR blend of the warped photos (black where a source does not see).
   torch::manual_seed(4);
-  FvsNet net(ModelConfig::ForVariant("fvs_agg"));
+  FvsNet net(ModelConfig::ForVariant(GetParam()));
   EXPECT_EQ(net->config().EncodedChannels(), 3);
   EXPECT_EQ(net->EncoderParameterCount(), 0);
   EXPECT_DOUBLE_EQ(net->EncodeFlops(270, 480), 0.0);
@@ -299,11 +304,13 @@ TEST(FvsAggTest, StartsAsTheUlrBlendAndLearnsEverywhere) {
   EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_agg","blend_channels":[8]})"),
                Error);
   EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs","blender":"mlp"})"), Error);
+  EXPECT_THROW(ModelConfig::FromJson(R"({"variant":"fvs_fast","relative_inputs":true})"),
+               Error);
 }
 
-TEST(FvsAggTest, ExtremeInputsStayFinite) {
+TEST_P(FvsAggTest, ExtremeInputsStayFinite) {
   torch::manual_seed(5);
-  FvsNet net(ModelConfig::ForVariant("fvs_agg"));
+  FvsNet net(ModelConfig::ForVariant(GetParam()));
   // Random (not zero) heads, so the extreme inputs reach the blend.
   {
     torch::NoGradGuard no_grad;
