@@ -141,7 +141,8 @@ exec nice -n "$NICE" env FVS_NUM_THREADS="${FVS_NUM_THREADS:-$(nproc)}" \
   --scene_list train_h$SCALE.txt --val_scene_list val_h$SCALE.txt \
   --output_path "runs/${FVS_RUN:-fvs_agg_h}" --Train.holdout_targets 1 \
   ${FVS_INIT:+--Train.init_weights "$FVS_INIT"} \
-  --Train.variant "${FVS_VARIANT:-fvs_agg}" --Train.crop 128 --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
+  --Train.variant "${FVS_VARIANT:-fvs_agg}" --Train.crop 128 \
+  --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
   --Train.batch_size 4 --Train.learning_rate "${FVS_LR:-2e-4}" --Train.val_every 250 \
   --Train.val_views 4 --Train.log_every 25 --Train.checkpoint_minutes 10 --Train.loss "$LOSS" \
   --Train.choice_weight "${FVS_CHOICE:-0}" --Train.lpips_weight "${FVS_LPIPS_WEIGHT:-1}"

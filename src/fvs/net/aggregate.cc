@@ -108,19 +108,20 @@ BlendOutput AggregateBlenderImpl::forward(const torch::Tensor& warped,
   // Per-source stack; log-weights scaled so that the floor (-9.2) is about -1.
   const double log_floor = -std::log(kUlrWeightFloor);
   const torch::Tensor difference = (warped - ulr) * v;
-  // The spread's floor (about 1 % of the colour range) keeps the ratio from amplifying
-  // the noise of sources that agree.
-  const torch::Tensor normalised =
-      relative_inputs_ ? (difference / (deviation + 0.02)).clamp(-4, 4) : torch::Tensor();
-  torch::Tensor x =
-      relative_inputs_
-          ? torch::cat({v, ulr_log / log_floor, ulr_weights, difference, normalised,
-                        per_source(deviation), per_source(vd), per_source(share)},
-                       1)
-          : torch::cat(
-                {colour, v, ulr_log / log_floor, ulr_weights, difference, per_source(ulr),
-                 per_source(deviation), per_source(vd), per_source(share)},
-                1);
+  // relative_inputs: the difference over the spread replaces U, and c_k is left out. The
+  // spread's floor (about 1 % of the colour range) keeps the ratio from amplifying the
+  // noise of sources that agree.
+  std::vector<torch::Tensor> inputs = {
+      v,
+      ulr_log / log_floor,
+      ulr_weights,
+      difference,
+      relative_inputs_ ? (difference / (deviation + 0.02)).clamp(-4, 4) : per_source(ulr),
+      per_source(deviation),
+      per_source(vd),
+      per_source(share)};
+  if (!relative_inputs_) inputs.insert(inputs.begin(), colour);
+  torch::Tensor x = torch::cat(inputs, 1);
   x = PadEven(x);
   torch::Tensor h = WithHalfResolutionContext(torch::relu(s_in_(x)), s_down1_, s_down2_,
                                               s_mix_, s_context_);
