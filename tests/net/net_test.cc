@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 
+#include "fvs/net/consensus.h"
 #include "fvs/util/error.h"
 
 namespace fvs {
@@ -509,6 +510,52 @@ TEST(WarpFeaturesTest, IdentityGridReproducesAndOutsideIsZero) {
     EXPECT_EQ(out.sizes().vec(), std::vector<int64_t>({2, 5, 4, 6}));
     EXPECT_TRUE(torch::equal(out, torch::zeros_like(out))) << v;
   }
+}
+
+// Colour consensus (net/consensus.h): sources that agree keep their weights, one that
+// disagrees over its window loses it, and the term stays finite and at most 0 for any
+// colours, tau or window.
+TEST(ConsensusTest, ADisagreeingSourceLosesItsWeightAndAgreeingOnesKeepTheirs) {
+  torch::manual_seed(3);
+  const torch::Tensor base = torch::rand({1, 3, 12, 14});
+  torch::Tensor colours = base.repeat({4, 1, 1, 1});
+  const torch::Tensor seen = torch::ones({4, 1, 12, 14});
+  const torch::Tensor log_weights = torch::zeros({4, 1, 12, 14});
+  ConsensusOptions options{0.05, 2, 1};
+  EXPECT_LT(
+      ConsensusLogWeights(colours, seen, log_weights, options).abs().max().item<float>(),
+      1e-6);
+  colours[3] = 1 - colours[3];
+  const torch::Tensor term = ConsensusLogWeights(colours, seen, log_weights, options);
+  EXPECT_LT(term[3].mean().item<float>(), -5.0);
+  EXPECT_GT(term.narrow(0, 0, 3).mean().item<float>(), term[3].mean().item<float>() + 4);
+  options.tau = 0;
+  EXPECT_EQ(
+      ConsensusLogWeights(colours, seen, log_weights, options).abs().max().item<float>(),
+      0);
+  for (const double tau : {1e-6, 0.05, 1e6}) {
+    options = {tau, 4, 3};
+    const torch::Tensor t = ConsensusLogWeights(
+        colours * 1e6, seen * (torch::rand_like(seen) > 0.5), log_weights, options);
+    EXPECT_TRUE(torch::isfinite(t).all().item<bool>()) << tau;
+    EXPECT_LE(t.max().item<float>(), 0) << tau;
+  }
+}
+
+// A source the proxy put one pixel off lands back on the others after alignment.
+TEST(ConsensusTest, AlignmentMovesAShiftedSourceBackOntoTheOthers) {
+  torch::manual_seed(4);
+  const torch::Tensor base = torch::rand({1, 3, 16, 18});
+  torch::Tensor colours = base.repeat({3, 1, 1, 1});
+  colours[2] = torch::roll(base[0], {1}, {2});  // one pixel to the right
+  torch::Tensor seen = torch::ones({3, 1, 16, 18});
+  const torch::Tensor log_weights = torch::log(torch::tensor({0.45f, 0.45f, 0.1f}))
+                                        .view({3, 1, 1, 1})
+                                        .expand({3, 1, 16, 18});
+  AlignToBlend(&colours, &seen, log_weights, {2, 2, 1e-4, 1});
+  const torch::Tensor interior = (colours[2] - base[0]).narrow(1, 3, 10).narrow(2, 3, 12);
+  EXPECT_LT(interior.abs().max().item<float>(), 1e-6);
+  EXPECT_TRUE(torch::isfinite(colours).all().item<bool>());
 }
 
 }  // namespace

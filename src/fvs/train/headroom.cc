@@ -1,9 +1,11 @@
 #include "fvs/train/headroom.h"
 
 #include <cmath>
-#include <iterator>
 #include <sstream>
+#include <string>
+#include <vector>
 
+#include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
 #include "fvs/train/loss.h"
 #include "fvs/util/atomic_file.h"
@@ -70,6 +72,47 @@ torch::Tensor PatchOracle(const torch::Tensor& colours, const torch::Tensor& see
   return torch::where(chosen_seen > 0.5, chosen, fallback);
 }
 
+// Blends that see no photo: the ULR weights with the colour-consensus term
+// (net/consensus.h) at a few settings.
+const ConsensusOptions kConsensus[] = {{0.03, 2, 1}, {0.06, 2, 1}, {0.1, 2, 1},
+                                       {0.06, 0, 1}, {0.06, 4, 1}, {0.06, 2, 2},
+                                       {0.03, 4, 2}, {0.06, 8, 1}, {0.15, 2, 1}};
+
+// The sources aligned to the blend by local shifts, then blended with the ULR weights.
+const AlignOptions kAlign[] = {{2, 2, 1e-3, 1}};
+
+std::vector<std::string> MethodNames() {
+  std::vector<std::string> names = {"ulr", "oracle_pixel", "oracle_global",
+                                    "oracle_patch8", "oracle_colour"};
+  for (const ConsensusOptions& c : kConsensus) {
+    std::ostringstream name;
+    name << "consensus_t" << c.tau << "_r" << c.radius << "_i" << c.iterations;
+    names.push_back(name.str());
+  }
+  for (const AlignOptions& a : kAlign) {
+    std::ostringstream name;
+    name << "align_s" << a.search << "_w" << a.window << "_p" << a.penalty << "_i"
+         << a.iterations;
+    names.push_back(name.str());
+  }
+  return names;
+}
+
+// The ULR blend with one affine colour transform per channel (gain and offset) fitted to
+// the photo on the covered pixels by least squares: how much of the error is a global
+// colour or exposure difference between the sources and the photo, which no blender can
+// know without the photo.
+torch::Tensor ColourOracle(const torch::Tensor& blend, const torch::Tensor& photo,
+                           const torch::Tensor& covered) {
+  const torch::Tensor n = covered.sum().clamp_min(1.0);
+  const torch::Tensor mx = (blend * covered).sum({0, 2, 3}, true) / n;
+  const torch::Tensor my = (photo * covered).sum({0, 2, 3}, true) / n;
+  const torch::Tensor dx = (blend - mx) * covered, dy = (photo - my) * covered;
+  const torch::Tensor gain =
+      (dx * dy).sum({0, 2, 3}, true) / (dx * dx).sum({0, 2, 3}, true).clamp_min(1e-9);
+  return (blend - mx) * gain + my;
+}
+
 }  // namespace
 
 std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
@@ -77,9 +120,8 @@ std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
                                          const SampleWarpOptions& warp_settings,
                                          const ImageDistance& lpips,
                                          bool holdout_targets) {
-  static constexpr const char* kMethods[] = {"ulr", "oracle_pixel", "oracle_global",
-                                             "oracle_patch8"};
-  constexpr int kNum = static_cast<int>(std::size(kMethods));
+  const std::vector<std::string> kMethods = MethodNames();
+  const int kNum = static_cast<int>(kMethods.size());
   std::vector<HeadroomRow> rows, all(kNum);
   const double no_lpips = lpips ? 0.0 : -1.0;
   for (int m = 0; m < kNum; ++m) all[m] = {"all", kMethods[m], 0, 0, 0, no_lpips};
@@ -96,14 +138,30 @@ std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
       const torch::Tensor colours = (WarpFeatures(s.source_rgb, s.warp.grid) + 1) * 0.5;
       const torch::Tensor seen = s.warp.valid_warp;
       const torch::Tensor covered = (seen.sum(0, true) > 0).to(torch::kFloat);
+      const torch::Tensor ulr_weights = SoftmaxWeights(s.warp.ulr_log_weights);
       const torch::Tensor ulr = [&] {
         torch::NoGradGuard no_grad;
-        return WeightedBlend(colours, seen, SoftmaxWeights(s.warp.ulr_log_weights));
+        return WeightedBlend(colours, seen, ulr_weights);
       }();
-      const torch::Tensor images[kNum] = {
+      std::vector<torch::Tensor> images = {
           ulr, PixelOracle(colours, seen, s.target_rgb),
           GlobalOracle(colours, seen, s.target_rgb, covered),
-          PatchOracle(colours, seen, s.target_rgb, ulr)};
+          PatchOracle(colours, seen, s.target_rgb, ulr),
+          ColourOracle(ulr, s.target_rgb, covered)};
+      for (const ConsensusOptions& c : kConsensus) {
+        torch::NoGradGuard no_grad;
+        const torch::Tensor log_weights = s.warp.ulr_log_weights;
+        images.push_back(WeightedBlend(
+            colours, seen,
+            SoftmaxWeights(log_weights +
+                           ConsensusLogWeights(colours, seen, log_weights, c))));
+      }
+      for (const AlignOptions& a : kAlign) {
+        torch::NoGradGuard no_grad;
+        torch::Tensor aligned = colours, aligned_seen = seen;
+        AlignToBlend(&aligned, &aligned_seen, s.warp.ulr_log_weights, a);
+        images.push_back(WeightedBlend(aligned, aligned_seen, ulr_weights));
+      }
       for (int m = 0; m < kNum; ++m) {
         torch::NoGradGuard no_grad;
         const torch::Tensor filled =
