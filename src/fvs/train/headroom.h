@@ -9,8 +9,12 @@
 // gives. The per-8x8-block oracle (one source per block, the one closest to the photo
 // over the block) is a choice that cannot follow the noise pixel by pixel: the per-pixel
 // oracle also wins by picking, among equally right sources, the one whose noise lands
-// nearest the photo, which no blender can predict. Pixels no source sees are filled as
-// the renderer fills them, the same for all.
+// nearest the photo, which no blender can predict. The colour oracle gives the `ulr`
+// blend one gain and offset per channel fitted to the photo: the part of the error that
+// is a global colour or exposure difference. Beside the oracles, blends that see no
+// photo (net/consensus.h): the ULR weights cut where a source disagrees with the blend
+// (consensus_*), and the sources shifted locally onto the blend before it (align_*).
+// Pixels no source sees are filled as the renderer fills them, the same for all.
 #pragma once
 
 #include <torch/torch.h>
@@ -25,7 +29,8 @@ namespace fvs {
 
 struct HeadroomRow {
   std::string scene;
-  std::string method;  // ulr | oracle_pixel | oracle_global | oracle_patch8
+  std::string method;  // ulr | oracle_pixel | oracle_global | oracle_patch8 |
+                       // oracle_colour | consensus_<settings> | align_<settings>
   int views = 0;
   double psnr = 0, ssim = 0;
   double lpips = -1;  // -1: no LPIPS function given
