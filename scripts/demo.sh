@@ -36,9 +36,12 @@ last=$(ls "$OUT/synthetic/images" | sort | tail -n 1)
 "$COLMAP" view_synthesis --workspace_path "$OUT/workspace" --output_path "$OUT/novel_views_ulr" \
   --method ulr --interpolate 4
 if ls models/*.safetensors >/dev/null 2>&1; then
+  # models/<variant>.safetensors: the method is the variant the file is named for.
   model=$(ls models/*.safetensors | head -n 1)
+  variant=$(basename "$model" .safetensors)
   "$COLMAP" view_synthesis --workspace_path "$OUT/workspace" \
-    --output_path "$OUT/novel_views_fvs" --method fvs --model_path "$model" --interpolate 4
+    --output_path "$OUT/novel_views_$variant" --method "$variant" --model_path "$model" \
+    --interpolate 4
 fi
 
 # 4. A short fly-through: a Ceres-smoothed path through five registered cameras, rendered
