@@ -15,7 +15,8 @@
 # blend), FVS_TRAIN_STEPS (default 200000), FVS_RUN (the run folder under runs/, default
 # fvs_agg_h), FVS_INIT (weights a new run starts from; a run with checkpoints resumes from
 # them), FVS_CHOICE (the weight of the choice term, train/loss.h; 0 = off), FVS_LOSS and
-# FVS_LPIPS_WEIGHT (l1+ssim+lpips and 1 with the LPIPS weights), FVS_LR
+# FVS_LPIPS_WEIGHT (l1+ssim+lpips and 1 with the LPIPS weights), FVS_FROZEN (parameter
+# names kept at their start, --Train.frozen; e.g. agg_confidence), FVS_LR
 # (2e-4), FVS_PACK_SCALE (0.5; the real scenes' pack size, 1 = the size
 # view_synthesis_eval renders them at; other scales pack into packed_s<scale>/) and
 # FVS_PREPARE_ONLY=1 steer it.
@@ -145,4 +146,5 @@ exec nice -n "$NICE" env FVS_NUM_THREADS="${FVS_NUM_THREADS:-$(nproc)}" \
   --Train.max_steps "${FVS_TRAIN_STEPS:-200000}" \
   --Train.batch_size 4 --Train.learning_rate "${FVS_LR:-2e-4}" --Train.val_every 250 \
   --Train.val_views 4 --Train.log_every 25 --Train.checkpoint_minutes 10 --Train.loss "$LOSS" \
-  --Train.choice_weight "${FVS_CHOICE:-0}" --Train.lpips_weight "${FVS_LPIPS_WEIGHT:-1}"
+  --Train.choice_weight "${FVS_CHOICE:-0}" --Train.lpips_weight "${FVS_LPIPS_WEIGHT:-1}" \
+  ${FVS_FROZEN:+--Train.frozen "$FVS_FROZEN"}

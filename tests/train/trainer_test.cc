@@ -245,6 +245,47 @@ TEST_F(TrainerTest, BestModelInitWeightsAndTimeBudget) {
   EXPECT_THROW(RunTraining(init), Error);
 }
 
+// --Train.frozen: the parameters named keep their starting values exactly, the others
+// train, the card says what was frozen, and a part no name contains is one clear error.
+TEST_F(TrainerTest, FrozenParametersKeepTheirStartingValues) {
+  const ModelConfig tiny = ModelConfig::FromJson(kTinyNet);
+  FvsNet start(tiny);
+  const std::string start_path = dir_->path() + "/frozen_start.safetensors";
+  SaveWeights(start, tiny, start_path, false);
+  TrainOptions o = Options("frozen");
+  o.init_weights = start_path;
+  o.frozen = "rgb_head, encoder_d0";
+  o.learning_rate = 1e-2;
+  const TrainSummary trained = RunTraining(o);
+  ModelConfig config;
+  FvsNet end = LoadModel(trained.model_path, &config);
+  const auto a = start->named_parameters(), b = end->named_parameters();
+  int frozen = 0, moved = 0;
+  for (const auto& item : a) {
+    const bool is_frozen = item.key().find("rgb_head") != std::string::npos ||
+                           item.key().find("encoder_d0") != std::string::npos;
+    const bool same = torch::equal(item.value(), b[item.key()]);
+    if (is_frozen) {
+      ++frozen;
+      EXPECT_TRUE(same) << item.key();
+    } else if (!same) {
+      ++moved;
+    }
+  }
+  EXPECT_GT(frozen, 0);
+  EXPECT_GT(moved, 0);
+  EXPECT_NE(ReadFileToString(o.output_path + "/model.json").find("\"frozen\""),
+            std::string::npos);
+  o.frozen = "no_such_module";
+  o.output_path = dir_->path() + "/frozen_bad";
+  try {
+    RunTraining(o);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_module"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(TrainerTest, CorruptNewestCheckpointFallsBackToThePrevious) {
   TrainOptions o = Options("corrupt");
   o.max_steps = 3;

@@ -74,9 +74,7 @@ torch::Tensor PatchOracle(const torch::Tensor& colours, const torch::Tensor& see
 
 // Blends that see no photo: the ULR weights with the colour-consensus term
 // (net/consensus.h) at a few settings.
-const ConsensusOptions kConsensus[] = {{0.03, 2, 1}, {0.06, 2, 1}, {0.1, 2, 1},
-                                       {0.06, 0, 1}, {0.06, 4, 1}, {0.06, 2, 2},
-                                       {0.03, 4, 2}, {0.06, 8, 1}, {0.15, 2, 1}};
+const ConsensusOptions kConsensus[] = {{0.1, 2, 1}, {0.15, 2, 1}};
 
 // The sources aligned to the blend by local shifts, then blended with the ULR weights.
 const AlignOptions kAlign[] = {{2, 2, 1e-3, 1}};
@@ -95,6 +93,8 @@ std::vector<std::string> MethodNames() {
          << a.iterations;
     names.push_back(name.str());
   }
+  names.push_back("exposure_gain");
+  names.push_back("exposure_affine");
   return names;
 }
 
@@ -111,6 +111,41 @@ torch::Tensor ColourOracle(const torch::Tensor& blend, const torch::Tensor& phot
   const torch::Tensor gain =
       (dx * dy).sum({0, 2, 3}, true) / (dx * dx).sum({0, 2, 3}, true).clamp_min(1e-9);
   return (blend - mx) * gain + my;
+}
+
+// Photo-free exposure matching: every source's colours mapped by one gain per channel
+// (and an offset, with `affine`) onto those of the anchor source, the one with the most
+// ULR weight over the view (the nearest), fitted on the pixels both see; then the ULR
+// blend. If a novel view is exposed like its nearest photo, the other photos' exposure
+// differences are what the blend should not mix in.
+torch::Tensor ExposureMatchedBlend(const torch::Tensor& colours,
+                                   const torch::Tensor& seen,
+                                   const torch::Tensor& ulr_weights, bool affine) {
+  const int64_t anchor = (ulr_weights * seen).sum({1, 2, 3}).argmax().item<int64_t>();
+  const torch::Tensor a = colours[anchor].unsqueeze(0);
+  const torch::Tensor both = seen * seen[anchor].unsqueeze(0);  // [K,1,H,W]
+  const torch::Tensor n = both.sum({2, 3}, true).clamp_min(1.0);
+  torch::Tensor matched;
+  if (affine) {
+    const torch::Tensor mc = (colours * both).sum({2, 3}, true) / n;
+    const torch::Tensor ma = (a * both).sum({2, 3}, true) / n;
+    const torch::Tensor dc = (colours - mc) * both, da = (a - ma) * both;
+    const torch::Tensor gain =
+        ((dc * da).sum({2, 3}, true) / (dc * dc).sum({2, 3}, true).clamp_min(1e-9))
+            .clamp(0.5, 2.0);
+    matched = (colours - mc) * gain + ma;
+  } else {
+    const torch::Tensor gain =
+        ((colours * a * both).sum({2, 3}, true) /
+         (colours * colours * both).sum({2, 3}, true).clamp_min(1e-9))
+            .clamp(0.5, 2.0);
+    matched = colours * gain;
+  }
+  // A source sharing fewer than 1 % of the pixels with the anchor keeps its colours.
+  const torch::Tensor enough =
+      (both.sum({2, 3}, true) > 0.01 * colours.size(2) * colours.size(3));
+  matched = torch::where(enough, matched, colours);
+  return WeightedBlend(matched.clamp(0, 1), seen, ulr_weights);
 }
 
 }  // namespace
@@ -161,6 +196,11 @@ std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
         torch::Tensor aligned = colours, aligned_seen = seen;
         AlignToBlend(&aligned, &aligned_seen, s.warp.ulr_log_weights, a);
         images.push_back(WeightedBlend(aligned, aligned_seen, ulr_weights));
+      }
+      {
+        torch::NoGradGuard no_grad;
+        images.push_back(ExposureMatchedBlend(colours, seen, ulr_weights, false));
+        images.push_back(ExposureMatchedBlend(colours, seen, ulr_weights, true));
       }
       for (int m = 0; m < kNum; ++m) {
         torch::NoGradGuard no_grad;

@@ -125,6 +125,10 @@ void AddTrainOptions(OptionManager* options, TrainOptions* o) {
   options->AddDefault("Train.choice_weight", &o->choice_weight,
                       "weight of the choice term (the blend weights' expected "
                       "per-source error; soft-argmax networks; 0 = off)");
+  options->AddDefault("Train.frozen", &o->frozen,
+                      "parameters whose names contain one of these comma-separated "
+                      "parts keep their starting values (e.g. agg_confidence: the "
+                      "ULR weights choose the sources, the rest trains)");
   options->AddDefault("Train.variant", &o->variant, "network variant");
   options->AddDefault(
       "Train.init_weights", &o->init_weights,

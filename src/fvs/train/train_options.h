@@ -27,6 +27,11 @@ struct TrainOptions {
   // > 0: adds this times ChoiceLoss (train/loss.h) for soft-argmax networks: the blend
   // weights' expected per-source error, which teaches the per-pixel choice of a source.
   double choice_weight = 0;
+  // Comma-separated parts of parameter names (e.g. "agg_confidence"): the parameters
+  // whose names contain one keep their starting values (not trained, not in Adam's
+  // state). A part that no name contains is an error. A resumed run must freeze the same
+  // ones (Adam's state is of the trained parameters).
+  std::string frozen;
   std::string variant = "fvs";
   // Start from these weights (their own variant and layout) instead of a fresh network;
   // a checkpoint in M still wins (resume). Fine-tuning (train/finetune.h) uses it.

@@ -31,6 +31,35 @@
 namespace fvs {
 namespace {
 
+// The parameters Adam trains: all but those whose names contain one of the
+// comma-separated parts of `frozen` (TrainOptions::frozen), which stop taking
+// gradients. Names are the weights file's (module paths, e.g.
+// agg_confidence.conv.weight).
+std::vector<torch::Tensor> TrainedParameters(FvsNetImpl& net, const std::string& frozen) {
+  std::vector<std::string> prefixes;
+  for (const std::string& part : SplitString(frozen, ",")) {
+    if (!TrimString(part).empty()) prefixes.push_back(TrimString(part));
+  }
+  std::vector<bool> used(prefixes.size(), false);
+  std::vector<torch::Tensor> trained;
+  for (auto& item : net.named_parameters()) {
+    bool keep = true;
+    for (size_t i = 0; i < prefixes.size(); ++i) {
+      if (item.key().find(prefixes[i]) == std::string::npos) continue;
+      used[i] = true;
+      keep = false;
+    }
+    item.value().set_requires_grad(keep);
+    if (keep) trained.push_back(item.value());
+  }
+  for (size_t i = 0; i < prefixes.size(); ++i) {
+    Require(used[i], "view_synthesis_train",
+            "--Train.frozen: no parameter name of this network contains '" + prefixes[i] +
+                "'");
+  }
+  return trained;
+}
+
 volatile std::sig_atomic_t g_stop_requested = 0;
 void RequestStop(int) { g_stop_requested = 1; }
 
@@ -235,7 +264,8 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
   net_ = init.is_empty() ? FvsNet(config_) : init;
   net_->to(device_);
   optimizer_ = std::make_unique<torch::optim::Adam>(
-      net_->parameters(), torch::optim::AdamOptions(options_.learning_rate));
+      TrainedParameters(*net_, options_.frozen),
+      torch::optim::AdamOptions(options_.learning_rate));
   SamplerOptions sampler;
   sampler.num_sources = k;
   sampler.crop = options_.crop;
@@ -413,6 +443,7 @@ std::string Trainer::SaveModel(const std::string& stem) {
   card["loss"] = loss_->Name();
   if (LossUsesLpips(loss_->Name())) card["lpips_weight"] = options_.lpips_weight;
   if (options_.choice_weight > 0) card["choice_weight"] = options_.choice_weight;
+  if (!options_.frozen.empty()) card["frozen"] = options_.frozen;
   if (!lpips_path_.empty()) card["lpips_weights"] = lpips_path_;
   card["steps"] = step_;
   card["batch_size"] = options_.batch_size;
