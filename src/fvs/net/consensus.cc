@@ -4,6 +4,23 @@
 
 namespace fvs {
 namespace F = torch::nn::functional;
+namespace {
+
+// The blend of the seeing sources with weights softmax(log_weights).
+torch::Tensor Blend(const torch::Tensor& colours, const torch::Tensor& seen,
+                    const torch::Tensor& log_weights) {
+  const torch::Tensor w = SoftmaxWeights(log_weights) * seen;
+  return (w * colours).sum(0, true) / w.sum(0, true).clamp_min(1e-12);
+}
+
+// x [K,C,H,W], padded by `pad` on every side, shifted so that out(y, x) = x(y + dy,
+// x + dx); where that falls outside x, the padding's values.
+torch::Tensor Shifted(const torch::Tensor& padded, int pad, int dy, int dx,
+                      int64_t height, int64_t width) {
+  return padded.narrow(2, pad + dy, height).narrow(3, pad + dx, width);
+}
+
+}  // namespace
 
 torch::Tensor BoxMean(const torch::Tensor& x, int radius) {
   if (radius <= 0) return x;
@@ -22,31 +39,13 @@ torch::Tensor ConsensusLogWeights(const torch::Tensor& colours, const torch::Ten
   // nothing: 0 over a floor, and its weight is already e^-9 there (the ULR floor).
   const torch::Tensor coverage = BoxMean(seen, options.radius).clamp_min(1e-3);
   for (int i = 0; i < options.iterations; ++i) {
-    const torch::Tensor w = SoftmaxWeights(log_weights + term) * seen;
-    const torch::Tensor blend =
-        (w * colours).sum(0, true) / w.sum(0, true).clamp_min(1e-12);
+    const torch::Tensor blend = Blend(colours, seen, log_weights + term);
     const torch::Tensor d =
         BoxMean((colours - blend).pow(2).mean(1, true) * seen, options.radius) / coverage;
     term = -(d * scale).clamp_max(30.0);
   }
   return term;
 }
-
-namespace {
-
-// x [K,C,H,W] shifted so that out(y, x) = x(y + dy, x + dx); outside: `fill`.
-torch::Tensor Shifted(const torch::Tensor& padded, int pad, int dy, int dx,
-                      int64_t height, int64_t width) {
-  return padded.narrow(2, pad + dy, height).narrow(3, pad + dx, width);
-}
-
-torch::Tensor Blend(const torch::Tensor& colours, const torch::Tensor& seen,
-                    const torch::Tensor& log_weights) {
-  const torch::Tensor w = SoftmaxWeights(log_weights) * seen;
-  return (w * colours).sum(0, true) / w.sum(0, true).clamp_min(1e-12);
-}
-
-}  // namespace
 
 void AlignToBlend(torch::Tensor* colours, torch::Tensor* seen,
                   const torch::Tensor& log_weights, const AlignOptions& options) {

@@ -36,26 +36,27 @@ namespace {
 // gradients. Names are the weights file's (module paths, e.g.
 // agg_confidence.conv.weight).
 std::vector<torch::Tensor> TrainedParameters(FvsNetImpl& net, const std::string& frozen) {
-  std::vector<std::string> prefixes;
+  std::vector<std::string> parts;
   for (const std::string& part : SplitString(frozen, ",")) {
-    if (!TrimString(part).empty()) prefixes.push_back(TrimString(part));
+    const std::string trimmed = TrimString(part);
+    if (!trimmed.empty()) parts.push_back(trimmed);
   }
-  std::vector<bool> used(prefixes.size(), false);
+  std::vector<bool> used(parts.size(), false);
   std::vector<torch::Tensor> trained;
   for (auto& item : net.named_parameters()) {
     bool keep = true;
-    for (size_t i = 0; i < prefixes.size(); ++i) {
-      if (item.key().find(prefixes[i]) == std::string::npos) continue;
+    for (size_t i = 0; i < parts.size(); ++i) {
+      if (item.key().find(parts[i]) == std::string::npos) continue;
       used[i] = true;
       keep = false;
     }
     item.value().set_requires_grad(keep);
     if (keep) trained.push_back(item.value());
   }
-  for (size_t i = 0; i < prefixes.size(); ++i) {
-    Require(used[i], "view_synthesis_train",
-            "--Train.frozen: no parameter name of this network contains '" + prefixes[i] +
-                "'");
+  for (size_t i = 0; i < parts.size(); ++i) {
+    Require(
+        used[i], "view_synthesis_train",
+        "--Train.frozen: no parameter name of this network contains '" + parts[i] + "'");
   }
   return trained;
 }
