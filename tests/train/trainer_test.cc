@@ -12,6 +12,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "fvs/net/net.h"
+#include "fvs/train/choice_evidence.h"
 #include "fvs/train/data.h"
 #include "fvs/train/headroom.h"
 #include "fvs/train/loss.h"
@@ -138,6 +140,55 @@ TEST_F(TrainerTest, HeadroomReportsUlrTheOraclesAndThePhotoFreeBlends) {
     EXPECT_LE(value, psnr["oracle_pixel"] + 1e-6) << method;
   }
   EXPECT_GT(consensus, 0);
+}
+
+// The choice evidence (train/choice_evidence.h) of a scene whose proxy is its true
+// surface: finite, bounded, zero for sources that do not see a pixel, the occlusion
+// residual small where a source sees the point; an unfitted model blends exactly as the
+// ULR weights do, and fitting lowers its L1 on the pixels it fits.
+TEST_F(TrainerTest, ChoiceEvidenceIsBoundedAndAFittedChoiceLowersItsError) {
+  torch::set_num_threads(1);
+  const PackedScene scene = LoadPackedScene(dir_->path() + "/scene_a");
+  SampleWarpOptions warp;
+  warp.ulr_log_weights = true;
+  const TrainingSample s = MakeSample(scene, 2, SelectTrainingSources(scene, 2, 3), 0, 0,
+                                      scene.width(), scene.height(), warp);
+  const torch::Tensor colours = (WarpFeatures(s.source_rgb, s.warp.grid) + 1) * 0.5;
+  const torch::Tensor e = SourceEvidence(scene, s, colours);
+  const torch::Tensor& seen = s.warp.valid_warp;
+  ASSERT_EQ(e.sizes(), (std::vector<int64_t>{3, kNumEvidence, 48, 64}));
+  EXPECT_TRUE(torch::isfinite(e).all().item<bool>());
+  EXPECT_LE(e.abs().max().item<double>(), 4.0);
+  EXPECT_EQ((e * (1 - seen)).abs().max().item<double>(), 0.0);
+  ASSERT_GT(seen.sum().item<double>(), 100);
+  const torch::Tensor occlusion = e.select(1, kEvidenceOcclusionAbs).unsqueeze(1);
+  EXPECT_LT(((occlusion * seen).sum() / seen.sum()).item<double>(), 0.1);
+  EXPECT_GT(e.select(1, kEvidenceBorder).max().item<double>(), 0.5);
+
+  ChoiceModel unfitted(16);
+  const torch::Tensor ulr = BlendSeen(colours, seen, s.warp.ulr_log_weights);
+  const torch::Tensor blend =
+      BlendSeen(colours, seen, unfitted->forward(e, s.warp.ulr_log_weights));
+  EXPECT_LT((blend - ulr).abs().max().item<double>(), 1e-6);
+
+  ChoiceFitOptions options;
+  options.hidden = 4;
+  options.steps = 60;
+  options.pixels_per_view = 512;
+  const ChoiceFit fit = FitChoiceModel({scene}, 2, warp, false, options, true);
+  EXPECT_EQ(fit.pixels, 512 * scene.num_views());
+  EXPECT_TRUE(std::isfinite(fit.final_l1));
+  EXPECT_LT(fit.final_l1, fit.start_l1);
+  // Rows for the fitted model in the headroom tool.
+  const auto rows =
+      MeasureHeadroom({scene}, 2, 2, warp, nullptr, false, {{"choice_mlp4", fit.model}});
+  int found = 0;
+  for (const HeadroomRow& r : rows) {
+    if (r.method != "choice_mlp4") continue;
+    ++found;
+    EXPECT_TRUE(std::isfinite(r.psnr) && std::isfinite(r.ssim));
+  }
+  EXPECT_EQ(found, 2);
 }
 
 TEST_F(TrainerTest, SsimIsOneForEqualImagesAndLowerOtherwise) {
@@ -285,7 +336,8 @@ TEST_F(TrainerTest, FrozenParametersKeepTheirStartingValues) {
     RunTraining(o);
     ADD_FAILURE() << "no error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("no_such_module"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no_such_module"), std::string::npos)
+        << e.what();
   }
 }
 

@@ -251,6 +251,7 @@ TrainingWarp ComputeTrainingWarp(
   out.grid = torch::empty({k, h, w, 2}, torch::kFloat);
   out.valid_depth = torch::empty({1, 1, h, w}, torch::kFloat);
   out.valid_warp = torch::empty({k, 1, h, w}, torch::kFloat);
+  out.source_z = torch::empty({k, 1, h, w}, torch::kFloat);
   const size_t n = static_cast<size_t>(h * w);
   std::vector<PinholeCamera> sources;
   for (int64_t s = 0; s < k; ++s) {
@@ -262,6 +263,8 @@ TrainingWarp ComputeTrainingWarp(
         GridSampleCoordinates(map, static_cast<int>(sw), static_cast<int>(sh));
     std::memcpy(out.grid[s].data_ptr<float>(), grid.data.data(), 2 * n * sizeof(float));
     std::memcpy(out.valid_warp[s].data_ptr<float>(), map.valid_warp.data.data(),
+                n * sizeof(float));
+    std::memcpy(out.source_z[s].data_ptr<float>(), map.source_z.data.data(),
                 n * sizeof(float));
     if (s == 0) {
       std::memcpy(out.valid_depth.data_ptr<float>(), map.valid_depth.data.data(),

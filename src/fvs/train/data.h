@@ -75,6 +75,9 @@ struct TrainingWarp {
   torch::Tensor grid;         // float [K,h,w,2], grid_sample (align_corners = false)
   torch::Tensor valid_depth;  // float [1,1,h,w]
   torch::Tensor valid_warp;   // float [K,1,h,w]
+  // float [K,1,h,w]: camera depth of each target pixel's point in each source (0 where
+  // the target pixel has no surface), WarpMap::source_z.
+  torch::Tensor source_z;
   // float [K,1,h,w], UlrLogWeights (only with SampleWarpOptions::ulr_log_weights).
   torch::Tensor ulr_log_weights;
 };

@@ -79,7 +79,7 @@ const ConsensusOptions kConsensus[] = {{0.1, 2, 1}, {0.15, 2, 1}};
 // The sources aligned to the blend by local shifts, then blended with the ULR weights.
 const AlignOptions kAlign[] = {{2, 2, 1e-3, 1}};
 
-std::vector<std::string> MethodNames() {
+std::vector<std::string> MethodNames(const std::vector<NamedChoiceModel>& choice) {
   std::vector<std::string> names = {"ulr", "oracle_pixel", "oracle_global",
                                     "oracle_patch8", "oracle_colour"};
   for (const ConsensusOptions& c : kConsensus) {
@@ -95,6 +95,7 @@ std::vector<std::string> MethodNames() {
   }
   names.push_back("exposure_gain");
   names.push_back("exposure_affine");
+  for (const NamedChoiceModel& c : choice) names.push_back(c.name);
   return names;
 }
 
@@ -153,9 +154,9 @@ torch::Tensor ExposureMatchedBlend(const torch::Tensor& colours,
 std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
                                          int num_sources, int views_per_scene,
                                          const SampleWarpOptions& warp_settings,
-                                         const ImageDistance& lpips,
-                                         bool holdout_targets) {
-  const std::vector<std::string> kMethods = MethodNames();
+                                         const ImageDistance& lpips, bool holdout_targets,
+                                         const std::vector<NamedChoiceModel>& choice) {
+  const std::vector<std::string> kMethods = MethodNames(choice);
   const int kNum = static_cast<int>(kMethods.size());
   std::vector<HeadroomRow> rows, all(kNum);
   const double no_lpips = lpips ? 0.0 : -1.0;
@@ -201,6 +202,13 @@ std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
         torch::NoGradGuard no_grad;
         images.push_back(ExposureMatchedBlend(colours, seen, ulr_weights, false));
         images.push_back(ExposureMatchedBlend(colours, seen, ulr_weights, true));
+        if (!choice.empty()) {
+          const torch::Tensor evidence = SourceEvidence(scene, s, colours);
+          for (NamedChoiceModel c : choice) {  // a holder: a shared pointer
+            images.push_back(BlendSeen(
+                colours, seen, c.model->forward(evidence, s.warp.ulr_log_weights)));
+          }
+        }
       }
       for (int m = 0; m < kNum; ++m) {
         torch::NoGradGuard no_grad;

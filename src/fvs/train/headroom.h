@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "fvs/train/choice_evidence.h"
 #include "fvs/train/data.h"
 
 namespace fvs {
@@ -39,14 +40,19 @@ struct HeadroomRow {
 // Distance of two [1,3,H,W] images in [0,1] (LPIPS); empty = not measured.
 using ImageDistance = std::function<double(const torch::Tensor&, const torch::Tensor&)>;
 
+// A blend of fitted per-pixel choice models (train/choice_evidence.h), a row each.
+struct NamedChoiceModel {
+  std::string name;
+  ChoiceModel model;
+};
+
 // The validation views of Trainer::Validate (ValidationTargets with `holdout_targets`,
 // top-K sources by overlap, full packed size), one row per scene and method, then the
 // means over all views (scene "all").
-std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
-                                         int num_sources, int views_per_scene,
-                                         const SampleWarpOptions& warp,
-                                         const ImageDistance& lpips,
-                                         bool holdout_targets = false);
+std::vector<HeadroomRow> MeasureHeadroom(
+    const std::vector<PackedScene>& scenes, int num_sources, int views_per_scene,
+    const SampleWarpOptions& warp, const ImageDistance& lpips,
+    bool holdout_targets = false, const std::vector<NamedChoiceModel>& choice = {});
 
 // Writes the rows as CSV (scene,method,views,psnr,ssim,lpips), atomically.
 void WriteHeadroomCsv(const std::string& path, const std::vector<HeadroomRow>& rows);

@@ -178,6 +178,9 @@ void AddTrainOptions(OptionManager* options, TrainOptions* o) {
       "Train.headroom", &o->headroom,
       "only measure ulr and the per-pixel and global oracles on the validation "
       "views (M/headroom.csv), no training");
+  options->AddDefault("Train.headroom_choice", &o->headroom_choice,
+                      "with --Train.headroom: also fit per-pixel choice models on the "
+                      "--scene_list targets and add their blends as rows");
   options->AddDefault(
       "Train.benchmark", &o->benchmark,
       "only the render benchmark: validation views of --val_scene_list rendered at "

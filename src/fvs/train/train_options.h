@@ -70,6 +70,10 @@ struct TrainOptions {
   // Only measure the headroom of the validation scenes (train/headroom.h) into
   // M/headroom.csv; no training.
   bool headroom = false;
+  // With headroom: also fit the per-pixel choice models of train/choice_evidence.h
+  // (linear and one hidden layer of 16) to the target views of --scene_list and add
+  // their blends as rows (choice_linear, choice_mlp16).
+  bool headroom_choice = false;
   // Only the trainer-only render benchmark (train/render_benchmark.h): renders
   // validation views of --val_scene_list with the network (--Train.init_weights, else a
   // fresh --Train.variant: timing only) and ulr, into M/render_benchmark.csv; no

@@ -596,9 +596,23 @@ TrainSummary RunHeadroom(const TrainOptions& options) {
       return lpips->forward(a, b).item<double>();
     };
   }
+  std::vector<NamedChoiceModel> choice;
+  if (options.headroom_choice) {
+    const std::vector<PackedScene> fit_scenes =
+        LoadScenes(options.scene_list, 2, options.num_sources);
+    for (const int hidden : {0, 16}) {
+      ChoiceFitOptions fit;
+      fit.hidden = hidden;
+      fit.seed = static_cast<uint64_t>(options.seed) + 1;
+      choice.push_back({hidden == 0 ? "choice_linear" : "choice_mlp16",
+                        FitChoiceModel(fit_scenes, options.num_sources, warp,
+                                       options.holdout_targets, fit, options.quiet)
+                            .model});
+    }
+  }
   const std::vector<HeadroomRow> rows = MeasureHeadroom(
       LoadScenes(options.val_scene_list, 2, options.num_sources), options.num_sources,
-      options.val_views, warp, distance, options.holdout_targets);
+      options.val_views, warp, distance, options.holdout_targets, choice);
   std::filesystem::create_directories(options.output_path);
   WriteHeadroomCsv(options.output_path + "/headroom.csv", rows);
   for (const HeadroomRow& r : rows) {
