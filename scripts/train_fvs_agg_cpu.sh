@@ -106,11 +106,6 @@ SELECT_SCENES="ethiopian_head:3:OPENCV beer:3"
 # Targets are photos held out of the geometry, like any novel view: each training scene
 # is prepared once per fold (fold f holds out every 5th photo from the f-th), so with all
 # five folds every photo is a target once, each seen by no depth map of its workspace.
-for spec in $REPORT_SCENES; do
-  IFS=: read -r scene step <<< "$spec"
-  link_photos "$scene" "$step"
-  prepare_scene "$scene" 0 ws
-done
 for offset in $FOLDS; do
   for spec in $TRAIN_SCENES $SELECT_SCENES; do
     IFS=: read -r scene step model <<< "$spec"
@@ -119,6 +114,13 @@ for offset in $FOLDS; do
     prepare_scene "$scene" "$offset" ws_h$offset "$model"
     pack_scene ws_h$offset/$scene $PACKED/h$offset/$scene
   done
+done
+# The reported scenes last: training and selection data first, so that a run can start
+# (or a fit be measured) while these are prepared.
+for spec in $REPORT_SCENES; do
+  IFS=: read -r scene step <<< "$spec"
+  link_photos "$scene" "$step"
+  prepare_scene "$scene" 0 ws
 done
 [[ "${FVS_PREPARE_ONLY:-0}" == "1" ]] && exit 0
 
