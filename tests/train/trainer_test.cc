@@ -177,8 +177,8 @@ TEST_F(TrainerTest, ChoiceEvidenceIsBoundedAndAFittedChoiceLowersItsError) {
   options.pixels_per_view = 512;
   const ChoiceFit fit = FitChoiceModel({scene}, 2, warp, false, options, true);
   EXPECT_EQ(fit.pixels, 512 * scene.num_views());
-  EXPECT_TRUE(std::isfinite(fit.final_l1));
-  EXPECT_LT(fit.final_l1, fit.start_l1);
+  EXPECT_TRUE(std::isfinite(fit.final_error));
+  EXPECT_LT(fit.final_error, fit.start_error);
   // Rows for the fitted model in the headroom tool.
   const auto rows =
       MeasureHeadroom({scene}, 2, 2, warp, nullptr, false, {{"choice_mlp4", fit.model}});
@@ -189,6 +189,40 @@ TEST_F(TrainerTest, ChoiceEvidenceIsBoundedAndAFittedChoiceLowersItsError) {
     EXPECT_TRUE(std::isfinite(r.psnr) && std::isfinite(r.ssim));
   }
   EXPECT_EQ(found, 2);
+
+  // The squared-error fit of the local channels only leaves the per-view channels out.
+  options.squared_error = true;
+  options.local_only = true;
+  const ChoiceFit local = FitChoiceModel({scene}, 2, warp, false, options, true);
+  EXPECT_LT(local.final_error, local.start_error);
+  torch::Tensor changed = e.clone();
+  changed.narrow(1, kEvidenceCoverage, kNumEvidence - kEvidenceCoverage).fill_(3.0);
+  const torch::NoGradGuard no_grad;
+  ChoiceModel local_model = local.model, all_model = fit.model;  // holders
+  EXPECT_EQ((local_model->forward(changed, s.warp.ulr_log_weights) -
+             local_model->forward(e, s.warp.ulr_log_weights))
+                .abs()
+                .max()
+                .item<double>(),
+            0.0);
+  EXPECT_GT((all_model->forward(changed, s.warp.ulr_log_weights) -
+             all_model->forward(e, s.warp.ulr_log_weights))
+                .abs()
+                .max()
+                .item<double>(),
+            0.0);
+}
+
+TEST(ChoiceSpecs, ParseAndNameOrRefuseInOneLine) {
+  const std::vector<ChoiceFitOptions> fits = ParseChoiceSpecs("0:l1:all,16:l2:local");
+  ASSERT_EQ(fits.size(), 2u);
+  EXPECT_EQ(ChoiceSpecName(fits[0]), "choice_h0_l1_all");
+  EXPECT_EQ(ChoiceSpecName(fits[1]), "choice_h16_l2_local");
+  EXPECT_TRUE(ParseChoiceSpecs("").empty());
+  for (const char* bad : {"16", "16:l3:all", "x:l1:all", "16:l1:some", "16:l1:all:4",
+                          "-1:l1:all", "99999:l1:all"}) {
+    EXPECT_THROW(ParseChoiceSpecs(bad), Error) << bad;
+  }
 }
 
 TEST_F(TrainerTest, SsimIsOneForEqualImagesAndLowerOtherwise) {

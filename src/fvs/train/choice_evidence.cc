@@ -2,8 +2,10 @@
 
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 
 #include "fvs/net/net.h"
+#include "fvs/util/error.h"
 
 namespace fvs {
 namespace {
@@ -61,6 +63,13 @@ torch::Tensor SourceSharpness(const torch::Tensor& source_rgb,
                             .align_corners(false));
 }
 
+// Mean of x [K,1,h,w] over the pixels each source sees, broadcast back: [K,1,h,w].
+torch::Tensor MeanOverSeen(const torch::Tensor& x, const torch::Tensor& seen) {
+  const torch::Tensor mean =
+      (x * seen).sum({2, 3}, true) / seen.sum({2, 3}, true).clamp_min(1);
+  return mean.expand_as(x);
+}
+
 // x less its mean over the sources that see each pixel.
 torch::Tensor RelativeToSeeing(const torch::Tensor& x, const torch::Tensor& seen) {
   const torch::Tensor mean = (x * seen).sum(0, true) / seen.sum(0, true).clamp_min(1);
@@ -68,6 +77,18 @@ torch::Tensor RelativeToSeeing(const torch::Tensor& x, const torch::Tensor& seen
 }
 
 }  // namespace
+
+const char* EvidenceChannelName(int channel) {
+  static const char* const kNames[kNumEvidence] = {
+      "ulr_log_weight",   "occlusion",
+      "occlusion_abs",    "footprint",
+      "footprint_coarse", "border",
+      "sharpness",        "blend_distance5",
+      "blend_distance",   "seen_share",
+      "surface",          "coverage",
+      "global_sharpness", "global_blend_distance"};
+  return channel >= 0 && channel < kNumEvidence ? kNames[channel] : "?";
+}
 
 torch::Tensor BlendSeen(const torch::Tensor& colours, const torch::Tensor& seen,
                         const torch::Tensor& log_weights) {
@@ -98,18 +119,29 @@ torch::Tensor SourceEvidence(const PackedScene& scene, const TrainingSample& s,
   const torch::Tensor border =
       torch::minimum(torch::minimum(u, sw - u), torch::minimum(v, sh - v)).unsqueeze(1);
   ch[kEvidenceBorder] = (border / 16).clamp(0, 1) * seen;
-  ch[kEvidenceSharpness] =
-      RelativeToSeeing(SourceSharpness(s.source_rgb, s.warp.grid), seen).clamp(-4, 4);
+  const torch::Tensor sharpness = SourceSharpness(s.source_rgb, s.warp.grid);
+  ch[kEvidenceSharpness] = RelativeToSeeing(sharpness, seen).clamp(-4, 4);
   const torch::Tensor blend = BlendSeen(colours, seen, s.warp.ulr_log_weights);
   const torch::Tensor distance = (colours - blend).abs().mean(1, true) * seen;
   ch[kEvidenceBlendDistance] = (10 * distance).clamp(0, 4);
   ch[kEvidenceBlendDistance5] = (10 * BoxMean5(distance)).clamp(0, 4) * seen;
   ch[kEvidenceSeenShare] = (seen.sum(0, true) / k).expand({k, 1, h, w}) * seen;
   ch[kEvidenceSurface] = s.warp.valid_depth.expand({k, 1, h, w}) * seen;
+  ch[kEvidenceCoverage] = seen.mean({2, 3}, true).expand({k, 1, h, w}) * seen;
+  const torch::Tensor global_sharpness = MeanOverSeen(sharpness, seen);
+  ch[kEvidenceGlobalSharpness] =
+      ((global_sharpness - global_sharpness.mean(0, true)) * seen).clamp(-4, 4);
+  ch[kEvidenceGlobalBlendDistance] =
+      (10 * MeanOverSeen(distance, seen)).clamp(0, 4) * seen;
   return torch::nan_to_num(torch::cat(ch, 1), 0, 0, 0);
 }
 
-ChoiceModelImpl::ChoiceModelImpl(int hidden_units) : hidden(hidden_units) {
+ChoiceModelImpl::ChoiceModelImpl(int hidden_units, bool local_only)
+    : hidden(hidden_units) {
+  channel_mask = torch::ones({kNumEvidence});
+  if (local_only)
+    channel_mask.narrow(0, kEvidenceCoverage, kNumEvidence - kEvidenceCoverage).zero_();
+  channel_mask = register_buffer("channel_mask", channel_mask);
   const int64_t out_of_first = hidden > 0 ? hidden : 1;
   first = register_module("first", torch::nn::Linear(kNumEvidence, out_of_first));
   torch::Tensor last_weight = first->weight;
@@ -124,10 +156,41 @@ ChoiceModelImpl::ChoiceModelImpl(int hidden_units) : hidden(hidden_units) {
 
 torch::Tensor ChoiceModelImpl::forward(const torch::Tensor& evidence,
                                        const torch::Tensor& ulr_log_weights) {
-  torch::Tensor x = evidence.movedim(1, -1);  // [K,...,F]
+  torch::Tensor x = evidence.movedim(1, -1) * channel_mask;  // [K,...,F]
   x = first->forward(x);
   if (hidden > 0) x = second->forward(torch::relu(x));
   return ulr_log_weights + x.movedim(-1, 1);
+}
+
+std::vector<ChoiceFitOptions> ParseChoiceSpecs(const std::string& specs) {
+  std::vector<ChoiceFitOptions> fits;
+  std::stringstream list(specs);
+  std::string spec;
+  while (std::getline(list, spec, ',')) {
+    if (spec.empty()) continue;
+    std::stringstream parts(spec);
+    std::string hidden, loss, channels, extra;
+    std::getline(parts, hidden, ':');
+    std::getline(parts, loss, ':');
+    std::getline(parts, channels, ':');
+    const bool digits = !hidden.empty() && hidden.size() <= 4 &&
+                        hidden.find_first_not_of("0123456789") == std::string::npos;
+    Require(digits && (loss == "l1" || loss == "l2") &&
+                (channels == "all" || channels == "local") && !std::getline(parts, extra),
+            "--Train.headroom_choice",
+            "'" + spec + "' is not HIDDEN:l1|l2:all|local (e.g. 16:l2:local)");
+    ChoiceFitOptions fit;
+    fit.hidden = std::stoi(hidden);
+    fit.squared_error = loss == "l2";
+    fit.local_only = channels == "local";
+    fits.push_back(fit);
+  }
+  return fits;
+}
+
+std::string ChoiceSpecName(const ChoiceFitOptions& fit) {
+  return "choice_h" + std::to_string(fit.hidden) + (fit.squared_error ? "_l2" : "_l1") +
+         (fit.local_only ? "_local" : "_all");
 }
 
 ChoiceFit FitChoiceModel(const std::vector<PackedScene>& scenes, int num_sources,
@@ -162,7 +225,7 @@ ChoiceFit FitChoiceModel(const std::vector<PackedScene>& scenes, int num_sources
     }
   }
   ChoiceFit fit;
-  fit.model = ChoiceModel(options.hidden);
+  fit.model = ChoiceModel(options.hidden, options.local_only);
   if (ev.empty()) return fit;
   const torch::Tensor e = torch::cat(ev, 2), c = torch::cat(col, 2),
                       v = torch::cat(seen, 2), l = torch::cat(lw, 2),
@@ -173,13 +236,15 @@ ChoiceFit FitChoiceModel(const std::vector<PackedScene>& scenes, int num_sources
   for (int step = 0; step <= options.steps; ++step) {
     adam.zero_grad();
     const torch::Tensor blend = BlendSeen(c, v, fit.model->forward(e, l));
-    const torch::Tensor loss = (blend - p).abs().mean();
-    fit.final_l1 = loss.item<double>();
-    if (step == 0) fit.start_l1 = fit.final_l1;
+    const torch::Tensor loss =
+        options.squared_error ? (blend - p).pow(2).mean() : (blend - p).abs().mean();
+    fit.final_error = loss.item<double>();
+    if (step == 0) fit.start_error = fit.final_error;
     if (step % 100 == 0 && !quiet) {
       std::cerr << "[choice] hidden " << options.hidden << " step " << step << " of "
-                << options.steps << ": L1 " << std::setprecision(5) << fit.final_l1
-                << " on " << p.size(2) << " pixels\n";
+                << options.steps << (options.squared_error ? ": squared error " : ": L1 ")
+                << std::setprecision(5) << fit.final_error << " on " << p.size(2)
+                << " pixels\n";
     }
     if (step == options.steps) break;
     loss.backward();

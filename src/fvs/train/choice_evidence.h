@@ -29,8 +29,17 @@ enum EvidenceChannel {
   kEvidenceBlendDistance,   // the same at the pixel
   kEvidenceSeenShare,       // share of the K sources that see the pixel
   kEvidenceSurface,         // 1 where the target pixel has a surface (not infinity)
+  // Per source, constant over the view (what the best global weighting of the headroom
+  // tool can key on): the share of the view the source sees, its mean sharpness less the
+  // sources' mean, and 10 x its mean colour distance to the ULR blend.
+  kEvidenceCoverage,
+  kEvidenceGlobalSharpness,
+  kEvidenceGlobalBlendDistance,
   kNumEvidence
 };
+
+// A short name of each channel ("occlusion", ...), for reports.
+const char* EvidenceChannelName(int channel);
 
 // float [K, kNumEvidence, h, w] for sample `s` of `scene` (full-size sources, the ULR
 // log-weights computed) and its warped colours [K,3,h,w] in [0,1]. Every channel is
@@ -40,18 +49,23 @@ torch::Tensor SourceEvidence(const PackedScene& scene, const TrainingSample& s,
 
 // Blend log-weights [K,1,h,w] = ULR log-weights + g(evidence of the source), one g shared
 // by all sources: linear (hidden 0) or one hidden ReLU layer. g starts at zero, so an
-// unfitted model blends exactly as `ulr` does.
+// unfitted model blends exactly as `ulr` does. `local_only` hides the per-view channels
+// (kEvidenceCoverage and after): a handful of views gives them a handful of values each,
+// too few to fit without learning the views.
 struct ChoiceModelImpl : torch::nn::Module {
-  explicit ChoiceModelImpl(int hidden);
+  explicit ChoiceModelImpl(int hidden, bool local_only = false);
   torch::Tensor forward(const torch::Tensor& evidence,
                         const torch::Tensor& ulr_log_weights);
   int hidden;
+  torch::Tensor channel_mask;  // [kNumEvidence], 0 for hidden channels
   torch::nn::Linear first{nullptr}, second{nullptr};
 };
 TORCH_MODULE(ChoiceModel);
 
 struct ChoiceFitOptions {
   int hidden = 0;
+  bool local_only = false;     // ChoiceModelImpl
+  bool squared_error = false;  // fit the squared error (PSNR's) instead of L1
   int steps = 400;
   double learning_rate = 0.02;
   int pixels_per_view = 8192;  // random covered pixels of each target view
@@ -60,9 +74,16 @@ struct ChoiceFitOptions {
 
 struct ChoiceFit {
   ChoiceModel model{nullptr};
-  int64_t pixels = 0;                 // fitted on (0: no target view had K sources)
-  double start_l1 = 0, final_l1 = 0;  // of the blend on those pixels (start: `ulr`'s)
+  int64_t pixels = 0;  // fitted on (0: no target view had K sources)
+  double start_error = 0,
+         final_error = 0;  // the fitted error on those pixels (start: `ulr`'s)
 };
+
+// Fit settings from "HIDDEN:LOSS:CHANNELS,..." (LOSS l1 or l2, CHANNELS all or local);
+// "" gives none. Throws fvs::Error naming the spec that does not parse.
+std::vector<ChoiceFitOptions> ParseChoiceSpecs(const std::string& specs);
+// "choice_h16_l2_local" and the like: the headroom row of a fit.
+std::string ChoiceSpecName(const ChoiceFitOptions& fit);
 
 // Fits a ChoiceModel to the target views of `scenes` (IsTargetView with
 // `holdout_targets`, those with K sources by overlap): the L1 error of its blend against

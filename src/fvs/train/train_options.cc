@@ -179,8 +179,9 @@ void AddTrainOptions(OptionManager* options, TrainOptions* o) {
       "only measure ulr and the per-pixel and global oracles on the validation "
       "views (M/headroom.csv), no training");
   options->AddDefault("Train.headroom_choice", &o->headroom_choice,
-                      "with --Train.headroom: also fit per-pixel choice models on the "
-                      "--scene_list targets and add their blends as rows");
+                      "with --Train.headroom: per-pixel choice models fitted on the "
+                      "--scene_list targets, as rows: HIDDEN:l1|l2:all|local,... "
+                      "(e.g. 0:l1:all,16:l2:local)");
   options->AddDefault(
       "Train.benchmark", &o->benchmark,
       "only the render benchmark: validation views of --val_scene_list rendered at "

@@ -70,10 +70,11 @@ struct TrainOptions {
   // Only measure the headroom of the validation scenes (train/headroom.h) into
   // M/headroom.csv; no training.
   bool headroom = false;
-  // With headroom: also fit the per-pixel choice models of train/choice_evidence.h
-  // (linear and one hidden layer of 16) to the target views of --scene_list and add
-  // their blends as rows (choice_linear, choice_mlp16).
-  bool headroom_choice = false;
+  // With headroom: also fit per-pixel choice models (train/choice_evidence.h) to the
+  // target views of --scene_list and add their blends as rows. Comma-separated specs
+  // HIDDEN:LOSS:CHANNELS, LOSS l1 or l2, CHANNELS all or local (e.g.
+  // "0:l1:all,16:l2:local"); empty: none.
+  std::string headroom_choice;
   // Only the trainer-only render benchmark (train/render_benchmark.h): renders
   // validation views of --val_scene_list with the network (--Train.init_weights, else a
   // fresh --Train.variant: timing only) and ulr, into M/render_benchmark.csv; no

@@ -597,18 +597,26 @@ TrainSummary RunHeadroom(const TrainOptions& options) {
     };
   }
   std::vector<NamedChoiceModel> choice;
-  if (options.headroom_choice) {
-    const std::vector<PackedScene> fit_scenes =
-        LoadScenes(options.scene_list, 2, options.num_sources);
-    for (const int hidden : {0, 16}) {
-      ChoiceFitOptions fit;
-      fit.hidden = hidden;
-      fit.seed = static_cast<uint64_t>(options.seed) + 1;
-      choice.push_back({hidden == 0 ? "choice_linear" : "choice_mlp16",
-                        FitChoiceModel(fit_scenes, options.num_sources, warp,
-                                       options.holdout_targets, fit, options.quiet)
-                            .model});
+  const std::vector<ChoiceFitOptions> fits = ParseChoiceSpecs(options.headroom_choice);
+  const std::vector<PackedScene> fit_scenes =
+      fits.empty() ? std::vector<PackedScene>()
+                   : LoadScenes(options.scene_list, 2, options.num_sources);
+  for (ChoiceFitOptions fit : fits) {
+    fit.seed = static_cast<uint64_t>(options.seed) + 1;
+    const ChoiceFit result = FitChoiceModel(fit_scenes, options.num_sources, warp,
+                                            options.holdout_targets, fit, options.quiet);
+    const std::string name = ChoiceSpecName(fit);
+    std::cout << name << ": error " << result.start_error << " (ulr) -> "
+              << result.final_error << " on " << result.pixels
+              << " pixels of the --scene_list targets\n";
+    if (fit.hidden == 0) {  // what a linear choice keys on
+      const torch::Tensor weight = result.model->first->weight.flatten();
+      for (int c = 0; c < kNumEvidence; ++c) {
+        std::cout << "  " << EvidenceChannelName(c) << " " << weight[c].item<double>()
+                  << "\n";
+      }
     }
+    choice.push_back({name, result.model});
   }
   const std::vector<HeadroomRow> rows = MeasureHeadroom(
       LoadScenes(options.val_scene_list, 2, options.num_sources), options.num_sources,
