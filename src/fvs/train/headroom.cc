@@ -7,6 +7,7 @@
 
 #include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
+#include "fvs/train/depth_sweep.h"
 #include "fvs/train/loss.h"
 #include "fvs/util/atomic_file.h"
 
@@ -79,6 +80,9 @@ const ConsensusOptions kConsensus[] = {{0.1, 2, 1}, {0.15, 2, 1}};
 // The sources aligned to the blend by local shifts, then blended with the ULR weights.
 const AlignOptions kAlign[] = {{2, 2, 1e-3, 1}};
 
+// The proxy's depth refined per pixel where the sources agree best (train/depth_sweep.h).
+const DepthSweepOptions kSweep[] = {{3, 0.03, 2, 1e-4}, {4, 0.06, 3, 1e-4}};
+
 std::vector<std::string> MethodNames(const std::vector<NamedChoiceModel>& choice) {
   std::vector<std::string> names = {"ulr", "oracle_pixel", "oracle_global",
                                     "oracle_patch8", "oracle_colour"};
@@ -91,6 +95,11 @@ std::vector<std::string> MethodNames(const std::vector<NamedChoiceModel>& choice
     std::ostringstream name;
     name << "align_s" << a.search << "_w" << a.window << "_p" << a.penalty << "_i"
          << a.iterations;
+    names.push_back(name.str());
+  }
+  for (const DepthSweepOptions& d : kSweep) {
+    std::ostringstream name;
+    name << "sweep_" << d.max_relative * 100 << "pc_s" << d.steps << "_r" << d.radius;
     names.push_back(name.str());
   }
   names.push_back("exposure_gain");
@@ -197,6 +206,9 @@ std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
         torch::Tensor aligned = colours, aligned_seen = seen;
         AlignToBlend(&aligned, &aligned_seen, s.warp.ulr_log_weights, a);
         images.push_back(WeightedBlend(aligned, aligned_seen, ulr_weights));
+      }
+      for (const DepthSweepOptions& d : kSweep) {
+        images.push_back(DepthSweepBlend(scene, s, settings, d));
       }
       {
         torch::NoGradGuard no_grad;

@@ -1,0 +1,93 @@
+#include "fvs/train/depth_sweep.h"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "fvs/net/net.h"
+#include "fvs/util/error.h"
+
+namespace fvs {
+namespace {
+
+namespace F = torch::nn::functional;
+
+torch::Tensor BoxMean(const torch::Tensor& x, int radius) {  // [N,C,h,w]
+  if (radius == 0) return x;
+  return F::avg_pool2d(x, F::AvgPool2dFuncOptions(2 * radius + 1)
+                              .stride(1)
+                              .padding(radius)
+                              .count_include_pad(false));
+}
+
+}  // namespace
+
+void DepthSweepOptions::Check() const {
+  Require(steps >= 1 && steps <= 32, "DepthSweepOptions", "steps must be in [1, 32]");
+  Require(std::isfinite(max_relative) && max_relative > 0 && max_relative < 0.5,
+          "DepthSweepOptions", "max_relative must be in (0, 0.5)");
+  Require(radius >= 0 && radius <= 16, "DepthSweepOptions", "radius must be in [0, 16]");
+  Require(std::isfinite(prior) && prior >= 0, "DepthSweepOptions",
+          "prior must be finite and >= 0");
+}
+
+torch::Tensor DepthSweepBlend(const PackedScene& scene, const TrainingSample& s,
+                              const SampleWarpOptions& settings,
+                              const DepthSweepOptions& options, torch::Tensor* chosen) {
+  options.Check();
+  Require(s.warp.ulr_log_weights.defined(), "DepthSweepBlend",
+          "the sample has no ULR log-weights");
+  torch::NoGradGuard no_grad;
+  const torch::Tensor& seen = s.warp.valid_warp;  // [K,1,h,w]
+  const int64_t h = seen.size(2), w = seen.size(3);
+  Require(h == scene.height() && w == scene.width(), "DepthSweepBlend",
+          "needs a full-size sample");
+  // Normalised ULR weights among the seeing sources, fixed over the sweep.
+  const torch::Tensor raw =
+      SoftmaxWeights(s.warp.ulr_log_weights + (seen - 1) * 1e4) * seen;
+  const torch::Tensor weights = raw / raw.sum(0, true).clamp_min(1e-12);
+  const torch::Tensor sweepable = (seen.sum(0, true) >= 2) & (s.warp.valid_depth > 0);
+
+  const torch::Tensor idx = torch::tensor(
+      std::vector<int64_t>(s.sources.begin(), s.sources.end()), torch::kLong);
+  const torch::Tensor source_K = scene.K.index_select(0, idx);
+  const torch::Tensor source_R = scene.R.index_select(0, idx);
+  const torch::Tensor source_t = scene.t.index_select(0, idx);
+  const torch::Tensor source_depths = scene.depths.index_select(0, idx);
+  SampleWarpOptions geometry_only = settings;
+  geometry_only.ulr_log_weights = false;
+
+  torch::Tensor best_cost =
+      torch::full({1, 1, h, w}, std::numeric_limits<float>::infinity());
+  torch::Tensor best_blend, best_change = torch::zeros({1, 1, h, w});
+  for (int i = -options.steps; i <= options.steps; ++i) {
+    const double change = options.max_relative * i / options.steps;
+    const torch::Tensor grid =
+        i == 0
+            ? s.warp.grid
+            : ComputeTrainingWarp(scene.K[s.target], scene.R[s.target], scene.t[s.target],
+                                  scene.depths[s.target] * (1 + change), source_K,
+                                  source_R, source_t, source_depths, geometry_only)
+                  .grid;
+    const torch::Tensor colours =
+        torch::nan_to_num((WarpFeatures(s.source_rgb, grid) + 1) * 0.5, 0, 0, 0);
+    const torch::Tensor blend = (weights * colours).sum(0, true);  // [1,3,h,w]
+    const torch::Tensor variance =
+        (weights * (colours - blend).pow(2)).sum(0, true).sum(1, true);
+    const torch::Tensor cost = torch::nan_to_num(BoxMean(variance, options.radius), 1e3) +
+                               options.prior * std::abs(i) / options.steps;
+    if (i == -options.steps) best_blend = blend;
+    const torch::Tensor better =
+        (cost < best_cost) & (i == 0 ? torch::ones_like(sweepable) : sweepable);
+    best_cost = torch::where(better, cost, best_cost);
+    best_blend = torch::where(better, blend, best_blend);
+    best_change =
+        torch::where(better, torch::full_like(best_change, change), best_change);
+  }
+  // Pixels no candidate could score keep the proxy's depth (their blend at i = 0 won).
+  if (chosen != nullptr) *chosen = best_change;
+  return torch::nan_to_num(best_blend, 0, 0, 0).clamp(0, 1);
+}
+
+}  // namespace fvs
