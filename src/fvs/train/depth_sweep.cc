@@ -28,8 +28,9 @@ void DepthSweepOptions::Check() const {
   Require(std::isfinite(max_relative) && max_relative > 0 && max_relative < 0.5,
           "DepthSweepOptions", "max_relative must be in (0, 0.5)");
   Require(radius >= 0 && radius <= 16, "DepthSweepOptions", "radius must be in [0, 16]");
-  Require(std::isfinite(prior) && prior >= 0, "DepthSweepOptions",
-          "prior must be finite and >= 0");
+  Require(std::isfinite(prior) && prior >= 0 && std::isfinite(relative_prior) &&
+              relative_prior >= 0,
+          "DepthSweepOptions", "prior and relative_prior must be finite and >= 0");
 }
 
 torch::Tensor DepthSweepBlend(const PackedScene& scene, const TrainingSample& s,
@@ -75,8 +76,10 @@ torch::Tensor DepthSweepBlend(const PackedScene& scene, const TrainingSample& s,
     const torch::Tensor blend = (weights * colours).sum(0, true);  // [1,3,h,w]
     const torch::Tensor variance =
         (weights * (colours - blend).pow(2)).sum(0, true).sum(1, true);
-    const torch::Tensor cost = torch::nan_to_num(BoxMean(variance, options.radius), 1e3) +
-                               options.prior * std::abs(i) / options.steps;
+    const double away = static_cast<double>(std::abs(i)) / options.steps;
+    const torch::Tensor cost = torch::nan_to_num(BoxMean(variance, options.radius), 1e3) *
+                                   (1 + options.relative_prior * away) +
+                               options.prior * away;
     if (i == -options.steps) best_blend = blend;
     const torch::Tensor better =
         (cost < best_cost) & (i == 0 ? torch::ones_like(sweepable) : sweepable);

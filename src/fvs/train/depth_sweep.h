@@ -19,6 +19,10 @@ struct DepthSweepOptions {
   // Added to a candidate's cost per |step| / steps (in colour variance units), so that
   // where the sources agree about as well anyway the proxy's depth stays.
   double prior = 1e-4;
+  // And a candidate's cost is multiplied by 1 + relative_prior |step| / steps: a move
+  // must cut the disagreement by that share, not merely tie (flat and dark regions, where
+  // all depths agree about as well, keep the proxy's).
+  double relative_prior = 0;
   void Check() const;  // throws fvs::Error
 };
 

@@ -81,7 +81,8 @@ const ConsensusOptions kConsensus[] = {{0.1, 2, 1}, {0.15, 2, 1}};
 const AlignOptions kAlign[] = {{2, 2, 1e-3, 1}};
 
 // The proxy's depth refined per pixel where the sources agree best (train/depth_sweep.h).
-const DepthSweepOptions kSweep[] = {{3, 0.03, 2, 1e-4}, {4, 0.06, 3, 1e-4}};
+const DepthSweepOptions kSweep[] = {
+    {3, 0.03, 2, 1e-4, 0}, {4, 0.06, 3, 1e-4, 0}, {2, 0.02, 4, 1e-4, 0.5}};
 
 std::vector<std::string> MethodNames(const std::vector<NamedChoiceModel>& choice) {
   std::vector<std::string> names = {"ulr", "oracle_pixel", "oracle_global",
@@ -100,6 +101,7 @@ std::vector<std::string> MethodNames(const std::vector<NamedChoiceModel>& choice
   for (const DepthSweepOptions& d : kSweep) {
     std::ostringstream name;
     name << "sweep_" << d.max_relative * 100 << "pc_s" << d.steps << "_r" << d.radius;
+    if (d.relative_prior > 0) name << "_rel" << d.relative_prior;
     names.push_back(name.str());
   }
   names.push_back("exposure_gain");
