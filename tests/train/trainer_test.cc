@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "fvs/net/net.h"
 #include "fvs/train/choice_evidence.h"
@@ -217,6 +218,15 @@ TEST(ChoiceSpecs, ParseAndNameOrRefuseInOneLine) {
   EXPECT_EQ(ChoiceSpecName(fits[0]), "choice_h0_l1_all");
   EXPECT_EQ(ChoiceSpecName(fits[1]), "choice_h16_l2_local");
   EXPECT_TRUE(ParseChoiceSpecs("").empty());
+  std::set<std::string> names;  // one name a channel (the list follows the enum)
+  for (int c = 0; c < kNumEvidence; ++c) {
+    ASSERT_NE(EvidenceChannelName(c), nullptr) << c;
+    names.insert(EvidenceChannelName(c));
+  }
+  EXPECT_EQ(names.size(), static_cast<size_t>(kNumEvidence));
+  EXPECT_EQ(names.count("?"), 0u);
+  EXPECT_STREQ(EvidenceChannelName(kEvidenceGlobalBlendDistance),
+               "global_blend_distance");
   for (const char* bad : {"16", "16:l3:all", "x:l1:all", "16:l1:some", "16:l1:all:4",
                           "-1:l1:all", "99999:l1:all"}) {
     EXPECT_THROW(ParseChoiceSpecs(bad), Error) << bad;
