@@ -515,6 +515,19 @@ TEST(WarpFeaturesTest, IdentityGridReproducesAndOutsideIsZero) {
 // Colour consensus (net/consensus.h): sources that agree keep their weights, one that
 // disagrees over its window loses it, and the term stays finite and at most 0 for any
 // colours, tau or window.
+// The window means: equal inside the image; at a corner BoxMean counts the replicated
+// border, BoxMeanInImage only the pixels inside.
+TEST(ConsensusTest, BoxMeansAgreeInsideAndDifferAtTheBorderAsDocumented) {
+  const torch::Tensor x = torch::arange(36, torch::kFloat).reshape({1, 1, 6, 6});
+  const torch::Tensor replicated = BoxMean(x, 1), inside = BoxMeanInImage(x, 1);
+  EXPECT_TRUE(torch::allclose(replicated.narrow(2, 1, 4).narrow(3, 1, 4),
+                              inside.narrow(2, 1, 4).narrow(3, 1, 4)));
+  EXPECT_NEAR(inside[0][0][0][0].item<double>(), (0 + 1 + 6 + 7) / 4.0, 1e-5);
+  EXPECT_NEAR(replicated[0][0][0][0].item<double>(), (4 * 0 + 2 * 1 + 2 * 6 + 7) / 9.0,
+              1e-5);
+  EXPECT_TRUE(torch::equal(BoxMeanInImage(x, 0), x));
+}
+
 TEST(ConsensusTest, ADisagreeingSourceLosesItsWeightAndAgreeingOnesKeepTheirs) {
   torch::manual_seed(3);
   const torch::Tensor base = torch::rand({1, 3, 12, 14});

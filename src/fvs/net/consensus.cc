@@ -29,6 +29,14 @@ torch::Tensor BoxMean(const torch::Tensor& x, int radius) {
   return F::avg_pool2d(padded, F::AvgPool2dFuncOptions(2 * radius + 1).stride(1));
 }
 
+torch::Tensor BoxMeanInImage(const torch::Tensor& x, int radius) {
+  if (radius <= 0) return x;
+  return F::avg_pool2d(x, F::AvgPool2dFuncOptions(2 * radius + 1)
+                              .stride(1)
+                              .padding(radius)
+                              .count_include_pad(false));
+}
+
 torch::Tensor ConsensusLogWeights(const torch::Tensor& colours, const torch::Tensor& seen,
                                   const torch::Tensor& log_weights,
                                   const ConsensusOptions& options) {

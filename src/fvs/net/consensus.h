@@ -23,6 +23,9 @@ struct ConsensusOptions {
 
 // Box mean over a (2r+1)^2 window, the same size out (edges replicated); r = 0: x.
 torch::Tensor BoxMean(const torch::Tensor& x, int radius);
+// The same, but near the border the mean of the window's pixels inside the image (no
+// padding counted); r = 0: x.
+torch::Tensor BoxMeanInImage(const torch::Tensor& x, int radius);
 
 // The log-weight terms [K,1,H,W] (<= 0, finite) to add to `log_weights` [K,1,H,W].
 // colours [K,3,H,W] on [0, 1]; seen [K,1,H,W] (1 where the source sees the pixel); the

@@ -4,6 +4,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
 #include "fvs/util/error.h"
 
@@ -11,11 +12,6 @@ namespace fvs {
 namespace {
 
 namespace F = torch::nn::functional;
-
-torch::Tensor BoxMean5(const torch::Tensor& x) {  // [N,1,h,w]
-  return F::avg_pool2d(
-      x, F::AvgPool2dFuncOptions(5).stride(1).padding(2).count_include_pad(false));
-}
 
 // Finite difference along dim (replicating the last one), for the Jacobian.
 torch::Tensor Diff(const torch::Tensor& x, int64_t dim) {
@@ -55,7 +51,7 @@ torch::Tensor OcclusionResidual(const torch::Tensor& source_depths,  // [K,1,H,W
 torch::Tensor SourceSharpness(const torch::Tensor& source_rgb,
                               const torch::Tensor& grid) {
   const torch::Tensor lum = ((source_rgb + 1) * 0.5).mean(1, true);  // [K,1,H,W]
-  const torch::Tensor energy = BoxMean5(Diff(lum, 3).abs() + Diff(lum, 2).abs());
+  const torch::Tensor energy = BoxMeanInImage(Diff(lum, 3).abs() + Diff(lum, 2).abs(), 2);
   return F::grid_sample(torch::log(energy + 1e-3), torch::nan_to_num(grid, -2, -2, -2),
                         F::GridSampleFuncOptions()
                             .mode(torch::kBilinear)
@@ -124,7 +120,7 @@ torch::Tensor SourceEvidence(const PackedScene& scene, const TrainingSample& s,
   const torch::Tensor blend = BlendSeen(colours, seen, s.warp.ulr_log_weights);
   const torch::Tensor distance = (colours - blend).abs().mean(1, true) * seen;
   ch[kEvidenceBlendDistance] = (10 * distance).clamp(0, 4);
-  ch[kEvidenceBlendDistance5] = (10 * BoxMean5(distance)).clamp(0, 4) * seen;
+  ch[kEvidenceBlendDistance5] = (10 * BoxMeanInImage(distance, 2)).clamp(0, 4) * seen;
   ch[kEvidenceSeenShare] = (seen.sum(0, true) / k).expand({k, 1, h, w}) * seen;
   ch[kEvidenceSurface] = s.warp.valid_depth.expand({k, 1, h, w}) * seen;
   ch[kEvidenceCoverage] = seen.mean({2, 3}, true).expand({k, 1, h, w}) * seen;

@@ -5,24 +5,11 @@
 #include <limits>
 #include <vector>
 
+#include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
 #include "fvs/util/error.h"
 
 namespace fvs {
-namespace {
-
-namespace F = torch::nn::functional;
-
-torch::Tensor BoxMean(const torch::Tensor& x, int radius) {  // [N,C,h,w]
-  if (radius == 0) return x;
-  return F::avg_pool2d(x, F::AvgPool2dFuncOptions(2 * radius + 1)
-                              .stride(1)
-                              .padding(radius)
-                              .count_include_pad(false));
-}
-
-}  // namespace
-
 void DepthSweepOptions::Check() const {
   Require(steps >= 1 && steps <= 32, "DepthSweepOptions", "steps must be in [1, 32]");
   Require(std::isfinite(max_relative) && max_relative > 0 && max_relative < 0.5,
@@ -77,9 +64,10 @@ torch::Tensor DepthSweepBlend(const PackedScene& scene, const TrainingSample& s,
     const torch::Tensor variance =
         (weights * (colours - blend).pow(2)).sum(0, true).sum(1, true);
     const double away = static_cast<double>(std::abs(i)) / options.steps;
-    const torch::Tensor cost = torch::nan_to_num(BoxMean(variance, options.radius), 1e3) *
-                                   (1 + options.relative_prior * away) +
-                               options.prior * away;
+    const torch::Tensor cost =
+        torch::nan_to_num(BoxMeanInImage(variance, options.radius), 1e3) *
+            (1 + options.relative_prior * away) +
+        options.prior * away;
     if (i == -options.steps) best_blend = blend;
     const torch::Tensor better =
         (cost < best_cost) & (i == 0 ? torch::ones_like(sweepable) : sweepable);
