@@ -517,6 +517,24 @@ TEST(WarpFeaturesTest, IdentityGridReproducesAndOutsideIsZero) {
 // colours, tau or window.
 // The window means: equal inside the image; at a corner BoxMean counts the replicated
 // border, BoxMeanInImage only the pixels inside.
+// SeenWeights masks before the softmax: a hidden source with a huge log-weight does not
+// take the seeing sources' weight (masking after a softmax over all left them e^-40 each,
+// and their blend black); where nothing sees, all weights and the blend are 0.
+TEST(ConsensusTest, SeenWeightsAreASoftmaxOverTheSeeingSourcesOnly) {
+  const torch::Tensor log_weights =
+      torch::tensor({40.f, 0.f, std::log(3.f)}).view({3, 1, 1, 1});
+  const torch::Tensor seen = torch::tensor({0.f, 1.f, 1.f}).view({3, 1, 1, 1});
+  const torch::Tensor w = SeenWeights(log_weights, seen).flatten();
+  EXPECT_NEAR(w[0].item<float>(), 0, 1e-7);
+  EXPECT_NEAR(w[1].item<float>(), 0.25, 1e-6);
+  EXPECT_NEAR(w[2].item<float>(), 0.75, 1e-6);
+  const torch::Tensor colours = torch::tensor({9.f, 1.f, 2.f}).view({3, 1, 1, 1});
+  EXPECT_NEAR(BlendSeen(colours, seen, log_weights).item<float>(), 1.75, 1e-6);
+  EXPECT_EQ(BlendSeen(colours, torch::zeros_like(seen), log_weights).item<float>(), 0);
+  EXPECT_EQ(SeenWeights(log_weights, torch::zeros_like(seen)).abs().sum().item<float>(),
+            0);
+}
+
 TEST(ConsensusTest, BoxMeansAgreeInsideAndDifferAtTheBorderAsDocumented) {
   const torch::Tensor x = torch::arange(36, torch::kFloat).reshape({1, 1, 6, 6});
   const torch::Tensor replicated = BoxMean(x, 1), inside = BoxMeanInImage(x, 1);

@@ -13,9 +13,11 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
 #include "fvs/train/choice_evidence.h"
 #include "fvs/train/data.h"
+#include "fvs/train/depth_stereo.h"
 #include "fvs/train/depth_sweep.h"
 #include "fvs/train/headroom.h"
 #include "fvs/train/loss.h"
@@ -142,6 +144,22 @@ TEST_F(TrainerTest, HeadroomReportsUlrTheOraclesAndThePhotoFreeBlends) {
     EXPECT_LE(value, psnr["oracle_pixel"] + 1e-6) << method;
   }
   EXPECT_GT(consensus, 0);
+  EXPECT_EQ(psnr.count("stereo_3pc_s4_r3_p0.3_0.2_1_a0.5"), 1u);
+
+  // --Train.headroom_methods: only the rows asked for, the same figures; none is an
+  // error.
+  const auto some = MeasureHeadroom({scene}, 2, 2, SampleWarpOptions{}, nullptr, false,
+                                    {}, "ulr,stereo");
+  std::set<std::string> methods;
+  for (const HeadroomRow& r : some) {
+    methods.insert(r.method);
+    if (r.scene == "all") EXPECT_NEAR(r.psnr, psnr[r.method], 1e-9) << r.method;
+  }
+  EXPECT_EQ(methods.size(), 3u);
+  EXPECT_EQ(methods.count("ulr"), 1u);
+  EXPECT_THROW(
+      MeasureHeadroom({scene}, 2, 2, SampleWarpOptions{}, nullptr, false, {}, "nosuch"),
+      Error);
 }
 
 // The choice evidence (train/choice_evidence.h) of a scene whose proxy is its true
@@ -278,6 +296,66 @@ TEST_F(TrainerTest, DepthSweepFindsTheDepthWhereTheSourcesAgree) {
 
   options.steps = 0;
   EXPECT_THROW(DepthSweepBlend(off, s, warp, options), Error);
+}
+
+// Semi-global matching (train/depth_stereo.h): without penalties it is the cost summed
+// over its four paths (the same choice per pixel); with them a lone pixel whose cost
+// prefers another candidate than all its neighbours follows them, while a whole region
+// that prefers it keeps it.
+TEST(DepthStereoTest, SemiGlobalMatchingSmoothsLoneChoicesAndKeepsRegions) {
+  torch::Tensor cost = torch::rand({5, 9, 11}) * 0.1;
+  cost.select(0, 2).sub_(0.5);       // candidate 2 everywhere
+  cost.index_put_({4, 4, 5}, -1.0);  // one pixel prefers candidate 4
+  cost.index_put_({0, torch::indexing::Slice(0, 4), torch::indexing::Slice(0, 4)},
+                  -1.0);  // a 4x4 region candidate 0
+  const torch::Tensor plain = SemiGlobalAggregate(cost, 0, 0);
+  EXPECT_TRUE(plain.allclose(cost * 4, 1e-5, 1e-5));
+  const torch::Tensor choice = SemiGlobalAggregate(cost, 0.05, 0.8).argmin(0);
+  EXPECT_EQ(choice[4][5].item<int64_t>(), 2);
+  EXPECT_EQ(choice[1][1].item<int64_t>(), 0);
+  EXPECT_EQ(choice[7][8].item<int64_t>(), 2);
+  cost.index_put_({1, 1, 1}, std::numeric_limits<float>::quiet_NaN());
+  EXPECT_THROW(SemiGlobalAggregate(cost, 0.05, 0.6), Error);
+  EXPECT_THROW(SemiGlobalAggregate(torch::zeros({3, 4}), 0.05, 0.6), Error);
+}
+
+// The stereo refinement on the scene of the depth sweep's test: with the target's proxy
+// 3 % too far it moves the pixels back and renders closer to the photo than `ulr` over
+// the wrong proxy; bad options are refused.
+TEST_F(TrainerTest, DepthStereoFindsTheDepthWhereTheSourcesCorrelate) {
+  torch::set_num_threads(1);
+  const PackedScene scene = LoadPackedScene(dir_->path() + "/scene_a");
+  SampleWarpOptions warp;
+  warp.ulr_log_weights = true;
+  warp.geometry.occlusion_tolerance = 0.05;
+  const std::vector<int> sources = SelectTrainingSources(scene, 2, 3);
+  const auto psnr = [](const torch::Tensor& a, const torch::Tensor& b) {
+    return -10 * std::log10((a - b).pow(2).mean().item<double>());
+  };
+  PackedScene off = scene;
+  off.depths = scene.depths.clone();
+  off.depths[2].mul_(1.03f);
+  const TrainingSample s =
+      MakeSample(off, 2, sources, 0, 0, off.width(), off.height(), warp);
+  const torch::Tensor colours = (WarpFeatures(s.source_rgb, s.warp.grid) + 1) * 0.5;
+  const torch::Tensor ulr = BlendSeen(colours, s.warp.valid_warp, s.warp.ulr_log_weights);
+  DepthStereoOptions options;
+  options.radius = 2;
+  // This smooth texture correlates almost as well at every depth: no pull toward the
+  // proxy (with prior 0.02 the median stays at 0).
+  options.prior = 0;
+  options.absolute_weight = 0.5;
+  torch::Tensor chosen;
+  const torch::Tensor refined = DepthStereoBlend(off, s, warp, options, &chosen);
+  EXPECT_TRUE(torch::isfinite(refined).all().item<bool>());
+  const torch::Tensor sweepable =
+      (s.warp.valid_warp.sum(0, true) >= 2) & (s.warp.valid_depth > 0);
+  ASSERT_GT(sweepable.sum().item<int64_t>(), 200);
+  EXPECT_NEAR(chosen.masked_select(sweepable).median().item<double>(), -0.03, 0.008);
+  // Measured: 32.97 against 32.74 dB.
+  EXPECT_GT(psnr(refined, s.target_rgb), psnr(ulr, s.target_rgb) + 0.1);
+  options.p2 = options.p1 / 2;
+  EXPECT_THROW(DepthStereoBlend(off, s, warp, options), Error);
 }
 
 TEST_F(TrainerTest, SsimIsOneForEqualImagesAndLowerOtherwise) {

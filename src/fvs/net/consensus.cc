@@ -6,13 +6,6 @@ namespace fvs {
 namespace F = torch::nn::functional;
 namespace {
 
-// The blend of the seeing sources with weights softmax(log_weights).
-torch::Tensor Blend(const torch::Tensor& colours, const torch::Tensor& seen,
-                    const torch::Tensor& log_weights) {
-  const torch::Tensor w = SoftmaxWeights(log_weights) * seen;
-  return (w * colours).sum(0, true) / w.sum(0, true).clamp_min(1e-12);
-}
-
 // x [K,C,H,W], padded by `pad` on every side, shifted so that out(y, x) = x(y + dy,
 // x + dx); where that falls outside x, the padding's values.
 torch::Tensor Shifted(const torch::Tensor& padded, int pad, int dy, int dx,
@@ -27,6 +20,16 @@ torch::Tensor BoxMean(const torch::Tensor& x, int radius) {
   const torch::Tensor padded = F::pad(
       x, F::PadFuncOptions({radius, radius, radius, radius}).mode(torch::kReplicate));
   return F::avg_pool2d(padded, F::AvgPool2dFuncOptions(2 * radius + 1).stride(1));
+}
+
+torch::Tensor SeenWeights(const torch::Tensor& log_weights, const torch::Tensor& seen) {
+  const torch::Tensor w = SoftmaxWeights(log_weights + (seen - 1) * 1e4) * seen;
+  return w / w.sum(0, true).clamp_min(1e-12);
+}
+
+torch::Tensor BlendSeen(const torch::Tensor& colours, const torch::Tensor& seen,
+                        const torch::Tensor& log_weights) {
+  return (SeenWeights(log_weights, seen) * colours).sum(0, true);
 }
 
 torch::Tensor BoxMeanInImage(const torch::Tensor& x, int radius) {
@@ -47,7 +50,7 @@ torch::Tensor ConsensusLogWeights(const torch::Tensor& colours, const torch::Ten
   // nothing: 0 over a floor, and its weight is already e^-9 there (the ULR floor).
   const torch::Tensor coverage = BoxMean(seen, options.radius).clamp_min(1e-3);
   for (int i = 0; i < options.iterations; ++i) {
-    const torch::Tensor blend = Blend(colours, seen, log_weights + term);
+    const torch::Tensor blend = BlendSeen(colours, seen, log_weights + term);
     const torch::Tensor d =
         BoxMean((colours - blend).pow(2).mean(1, true) * seen, options.radius) / coverage;
     term = -(d * scale).clamp_max(30.0);
@@ -61,7 +64,7 @@ void AlignToBlend(torch::Tensor* colours, torch::Tensor* seen,
   const int r = options.search;
   const int64_t h = colours->size(2), w = colours->size(3);
   for (int it = 0; it < options.iterations; ++it) {
-    const torch::Tensor blend = Blend(*colours, *seen, log_weights);
+    const torch::Tensor blend = BlendSeen(*colours, *seen, log_weights);
     const torch::Tensor pc =
         F::pad(*colours, F::PadFuncOptions({r, r, r, r}).mode(torch::kReplicate));
     const torch::Tensor ps = F::pad(*seen, F::PadFuncOptions({r, r, r, r}));

@@ -21,6 +21,15 @@ struct ConsensusOptions {
   int iterations = 1;  // reweightings
 };
 
+// Blend weights [K,1,H,W] among the seeing sources: the softmax of `log_weights`
+// [K,1,H,W] over the sources that see each pixel (`seen` [K,1,H,W], 1 or 0), 0 for the
+// others and everywhere no source sees. Masked before the softmax, so the seeing sources
+// keep their weight however large a hidden source's log-weight is.
+torch::Tensor SeenWeights(const torch::Tensor& log_weights, const torch::Tensor& seen);
+// The blend [1,C,H,W] of colours [K,C,H,W] with SeenWeights (0 where no source sees).
+torch::Tensor BlendSeen(const torch::Tensor& colours, const torch::Tensor& seen,
+                        const torch::Tensor& log_weights);
+
 // Box mean over a (2r+1)^2 window, the same size out (edges replicated); r = 0: x.
 torch::Tensor BoxMean(const torch::Tensor& x, int radius);
 // The same, but near the border the mean of the window's pixels inside the image (no

@@ -86,12 +86,6 @@ const char* EvidenceChannelName(int channel) {
   return channel >= 0 && channel < kNumEvidence ? kNames[channel] : "?";
 }
 
-torch::Tensor BlendSeen(const torch::Tensor& colours, const torch::Tensor& seen,
-                        const torch::Tensor& log_weights) {
-  const torch::Tensor w = SoftmaxWeights(log_weights + (seen - 1) * 1e4) * seen;
-  return (w * colours).sum(0, true) / w.sum(0, true).clamp_min(1e-12);
-}
-
 torch::Tensor SourceEvidence(const PackedScene& scene, const TrainingSample& s,
                              const torch::Tensor& colours) {
   torch::NoGradGuard no_grad;

@@ -93,9 +93,4 @@ ChoiceFit FitChoiceModel(const std::vector<PackedScene>& scenes, int num_sources
                          const SampleWarpOptions& warp, bool holdout_targets,
                          const ChoiceFitOptions& options, bool quiet = false);
 
-// The blend of colours [K,3,h,w] among the seeing sources with log-weights [K,1,h,w]
-// (softmax over the seeing ones).
-torch::Tensor BlendSeen(const torch::Tensor& colours, const torch::Tensor& seen,
-                        const torch::Tensor& log_weights);
-
 }  // namespace fvs

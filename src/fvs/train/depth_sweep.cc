@@ -32,9 +32,7 @@ torch::Tensor DepthSweepBlend(const PackedScene& scene, const TrainingSample& s,
   Require(h == scene.height() && w == scene.width(), "DepthSweepBlend",
           "needs a full-size sample");
   // Normalised ULR weights among the seeing sources, fixed over the sweep.
-  const torch::Tensor raw =
-      SoftmaxWeights(s.warp.ulr_log_weights + (seen - 1) * 1e4) * seen;
-  const torch::Tensor weights = raw / raw.sum(0, true).clamp_min(1e-12);
+  const torch::Tensor weights = SeenWeights(s.warp.ulr_log_weights, seen);
   const torch::Tensor sweepable = (seen.sum(0, true) >= 2) & (s.warp.valid_depth > 0);
 
   const torch::Tensor idx = torch::tensor(

@@ -1,15 +1,19 @@
 #include "fvs/train/headroom.h"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
+#include "fvs/train/depth_stereo.h"
 #include "fvs/train/depth_sweep.h"
 #include "fvs/train/loss.h"
 #include "fvs/util/atomic_file.h"
+#include "fvs/util/error.h"
 
 namespace fvs {
 namespace {
@@ -17,13 +21,6 @@ namespace {
 double Psnr(const torch::Tensor& a, const torch::Tensor& b) {
   const double mse = (a - b).pow(2).mean().item<double>();
   return 10.0 * std::log10(1.0 / std::max(mse, 1e-10));
-}
-
-// Blend of colours [K,3,H,W] with weights [K,1,H,W] among the seeing sources.
-torch::Tensor WeightedBlend(const torch::Tensor& colours, const torch::Tensor& seen,
-                            const torch::Tensor& weights) {
-  const torch::Tensor w = weights * seen;
-  return (w * colours).sum(0, true) / w.sum(0, true).clamp_min(1e-12);
 }
 
 // Each pixel: the seeing source whose colour is closest (L1 over channels) to the photo.
@@ -44,13 +41,13 @@ torch::Tensor GlobalOracle(const torch::Tensor& colours, const torch::Tensor& se
   torch::optim::Adam adam({logits}, torch::optim::AdamOptions(0.1));
   for (int i = 0; i < 150; ++i) {
     adam.zero_grad();
-    const torch::Tensor blend = WeightedBlend(colours, seen, torch::softmax(logits, 0));
+    const torch::Tensor blend = BlendSeen(colours, seen, logits.expand_as(seen));
     const torch::Tensor loss = ((blend - photo).pow(2) * covered).mean();
     loss.backward();
     adam.step();
   }
   torch::NoGradGuard no_grad;
-  return WeightedBlend(colours, seen, torch::softmax(logits, 0));
+  return BlendSeen(colours, seen, logits.expand_as(seen));
 }
 
 // Each 8x8 block: the one seeing source whose colours are closest to the photo over the
@@ -84,6 +81,13 @@ const AlignOptions kAlign[] = {{2, 2, 1e-3, 1}};
 const DepthSweepOptions kSweep[] = {
     {3, 0.03, 2, 1e-4, 0}, {4, 0.06, 3, 1e-4, 0}, {2, 0.02, 4, 1e-4, 0.5}};
 
+// The same by per-view stereo: correlation cost, semi-global matching
+// (train/depth_stereo.h).
+// Settings chosen on two held-out views each of fold 0 of four training scenes; the
+// widest (+-3 %) with a large prior, and +-1 %.
+const DepthStereoOptions kStereo[] = {{4, 0.03, 3, 0.02, 0.3, 0.2, 1.0, 0.5},
+                                      {2, 0.01, 3, 0.01, 0.1, 0.1, 0.6, 0.5}};
+
 std::vector<std::string> MethodNames(const std::vector<NamedChoiceModel>& choice) {
   std::vector<std::string> names = {"ulr", "oracle_pixel", "oracle_global",
                                     "oracle_patch8", "oracle_colour"};
@@ -102,6 +106,12 @@ std::vector<std::string> MethodNames(const std::vector<NamedChoiceModel>& choice
     std::ostringstream name;
     name << "sweep_" << d.max_relative * 100 << "pc_s" << d.steps << "_r" << d.radius;
     if (d.relative_prior > 0) name << "_rel" << d.relative_prior;
+    names.push_back(name.str());
+  }
+  for (const DepthStereoOptions& d : kStereo) {
+    std::ostringstream name;
+    name << "stereo_" << d.max_relative * 100 << "pc_s" << d.steps << "_r" << d.radius
+         << "_p" << d.prior << "_" << d.p1 << "_" << d.p2 << "_a" << d.absolute_weight;
     names.push_back(name.str());
   }
   names.push_back("exposure_gain");
@@ -132,8 +142,9 @@ torch::Tensor ColourOracle(const torch::Tensor& blend, const torch::Tensor& phot
 // differences are what the blend should not mix in.
 torch::Tensor ExposureMatchedBlend(const torch::Tensor& colours,
                                    const torch::Tensor& seen,
-                                   const torch::Tensor& ulr_weights, bool affine) {
-  const int64_t anchor = (ulr_weights * seen).sum({1, 2, 3}).argmax().item<int64_t>();
+                                   const torch::Tensor& ulr_log_weights, bool affine) {
+  const int64_t anchor =
+      (SoftmaxWeights(ulr_log_weights) * seen).sum({1, 2, 3}).argmax().item<int64_t>();
   const torch::Tensor a = colours[anchor].unsqueeze(0);
   const torch::Tensor both = seen * seen[anchor].unsqueeze(0);  // [K,1,H,W]
   const torch::Tensor n = both.sum({2, 3}, true).clamp_min(1.0);
@@ -157,7 +168,19 @@ torch::Tensor ExposureMatchedBlend(const torch::Tensor& colours,
   const torch::Tensor enough =
       (both.sum({2, 3}, true) > 0.01 * colours.size(2) * colours.size(3));
   matched = torch::where(enough, matched, colours);
-  return WeightedBlend(matched.clamp(0, 1), seen, ulr_weights);
+  return BlendSeen(matched.clamp(0, 1), seen, ulr_log_weights);
+}
+
+// Whether `name` starts with one of the comma-separated prefixes of `methods` (all when
+// empty).
+bool Selected(const std::string& name, const std::string& methods) {
+  if (methods.empty()) return true;
+  std::istringstream list(methods);
+  std::string prefix;
+  while (std::getline(list, prefix, ',')) {
+    if (!prefix.empty() && name.rfind(prefix, 0) == 0) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -166,9 +189,14 @@ std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
                                          int num_sources, int views_per_scene,
                                          const SampleWarpOptions& warp_settings,
                                          const ImageDistance& lpips, bool holdout_targets,
-                                         const std::vector<NamedChoiceModel>& choice) {
+                                         const std::vector<NamedChoiceModel>& choice,
+                                         const std::string& methods) {
   const std::vector<std::string> kMethods = MethodNames(choice);
   const int kNum = static_cast<int>(kMethods.size());
+  std::vector<bool> selected(kNum);
+  for (int m = 0; m < kNum; ++m) selected[m] = Selected(kMethods[m], methods);
+  Require(std::find(selected.begin(), selected.end(), true) != selected.end(),
+          "--Train.headroom_methods", "'" + methods + "' selects no method");
   std::vector<HeadroomRow> rows, all(kNum);
   const double no_lpips = lpips ? 0.0 : -1.0;
   for (int m = 0; m < kNum; ++m) all[m] = {"all", kMethods[m], 0, 0, 0, no_lpips};
@@ -182,50 +210,62 @@ std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
       if (sources.empty()) continue;
       const TrainingSample s = MakeSample(scene, target, sources, 0, 0, scene.width(),
                                           scene.height(), settings);
+      torch::NoGradGuard no_grad;
       const torch::Tensor colours = (WarpFeatures(s.source_rgb, s.warp.grid) + 1) * 0.5;
       const torch::Tensor seen = s.warp.valid_warp;
       const torch::Tensor covered = (seen.sum(0, true) > 0).to(torch::kFloat);
-      const torch::Tensor ulr_weights = SoftmaxWeights(s.warp.ulr_log_weights);
-      const torch::Tensor ulr = [&] {
-        torch::NoGradGuard no_grad;
-        return WeightedBlend(colours, seen, ulr_weights);
-      }();
-      std::vector<torch::Tensor> images = {
-          ulr, PixelOracle(colours, seen, s.target_rgb),
-          GlobalOracle(colours, seen, s.target_rgb, covered),
-          PatchOracle(colours, seen, s.target_rgb, ulr),
-          ColourOracle(ulr, s.target_rgb, covered)};
+      const torch::Tensor ulr = BlendSeen(colours, seen, s.warp.ulr_log_weights);
+      // The methods' images in the order of kMethods; unselected ones stay undefined.
+      std::vector<torch::Tensor> images;
+      const auto add = [&](const std::function<torch::Tensor()>& render) {
+        images.push_back(selected[images.size()] ? render() : torch::Tensor());
+      };
+      add([&] { return ulr; });
+      add([&] { return PixelOracle(colours, seen, s.target_rgb); });
+      add([&] {
+        torch::AutoGradMode grad(true);  // the global oracle is fitted by Adam
+        return GlobalOracle(colours, seen, s.target_rgb, covered);
+      });
+      add([&] { return PatchOracle(colours, seen, s.target_rgb, ulr); });
+      add([&] { return ColourOracle(ulr, s.target_rgb, covered); });
       for (const ConsensusOptions& c : kConsensus) {
-        torch::NoGradGuard no_grad;
-        const torch::Tensor log_weights = s.warp.ulr_log_weights;
-        images.push_back(WeightedBlend(
-            colours, seen,
-            SoftmaxWeights(log_weights +
-                           ConsensusLogWeights(colours, seen, log_weights, c))));
+        add([&] {
+          const torch::Tensor log_weights = s.warp.ulr_log_weights;
+          return BlendSeen(
+              colours, seen,
+              log_weights + ConsensusLogWeights(colours, seen, log_weights, c));
+        });
       }
       for (const AlignOptions& a : kAlign) {
-        torch::NoGradGuard no_grad;
-        torch::Tensor aligned = colours, aligned_seen = seen;
-        AlignToBlend(&aligned, &aligned_seen, s.warp.ulr_log_weights, a);
-        images.push_back(WeightedBlend(aligned, aligned_seen, ulr_weights));
+        add([&] {
+          torch::Tensor aligned = colours, aligned_seen = seen;
+          AlignToBlend(&aligned, &aligned_seen, s.warp.ulr_log_weights, a);
+          return BlendSeen(aligned, aligned_seen, s.warp.ulr_log_weights);
+        });
       }
       for (const DepthSweepOptions& d : kSweep) {
-        images.push_back(DepthSweepBlend(scene, s, settings, d));
+        add([&] { return DepthSweepBlend(scene, s, settings, d); });
       }
-      {
-        torch::NoGradGuard no_grad;
-        images.push_back(ExposureMatchedBlend(colours, seen, ulr_weights, false));
-        images.push_back(ExposureMatchedBlend(colours, seen, ulr_weights, true));
-        if (!choice.empty()) {
-          const torch::Tensor evidence = SourceEvidence(scene, s, colours);
-          for (NamedChoiceModel c : choice) {  // a holder: a shared pointer
-            images.push_back(BlendSeen(
-                colours, seen, c.model->forward(evidence, s.warp.ulr_log_weights)));
-          }
+      for (const DepthStereoOptions& d : kStereo) {
+        add([&] { return DepthStereoBlend(scene, s, settings, d); });
+      }
+      add([&] {
+        return ExposureMatchedBlend(colours, seen, s.warp.ulr_log_weights, false);
+      });
+      add([&] {
+        return ExposureMatchedBlend(colours, seen, s.warp.ulr_log_weights, true);
+      });
+      if (!choice.empty()) {
+        const torch::Tensor evidence = SourceEvidence(scene, s, colours);
+        for (NamedChoiceModel c : choice) {  // a holder: a shared pointer
+          add([&] {
+            return BlendSeen(colours, seen,
+                             c.model->forward(evidence, s.warp.ulr_log_weights));
+          });
         }
       }
       for (int m = 0; m < kNum; ++m) {
-        torch::NoGradGuard no_grad;
+        if (!images[m].defined()) continue;
         const torch::Tensor filled =
             FillHolesOf(images[m].clamp(0, 1), covered, s.warp.valid_depth);
         HeadroomRow& r = mine[m];

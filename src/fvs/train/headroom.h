@@ -13,7 +13,9 @@
 // blend one gain and offset per channel fitted to the photo: the part of the error that
 // is a global colour or exposure difference. Beside the oracles, blends that see no
 // photo (net/consensus.h): the ULR weights cut where a source disagrees with the blend
-// (consensus_*), and the sources shifted locally onto the blend before it (align_*).
+// (consensus_*), the sources shifted locally onto the blend before it (align_*), the
+// proxy's depth refined per pixel (sweep_*, train/depth_sweep.h; stereo_*,
+// train/depth_stereo.h), exposure matching (exposure_*) and fitted choices (choice_*).
 // Pixels no source sees are filled as the renderer fills them, the same for all.
 #pragma once
 
@@ -31,7 +33,8 @@ namespace fvs {
 struct HeadroomRow {
   std::string scene;
   std::string method;  // ulr | oracle_pixel | oracle_global | oracle_patch8 |
-                       // oracle_colour | consensus_<settings> | align_<settings>
+                       // oracle_colour | consensus_<settings> | align_<settings> |
+                       // sweep_<settings> | stereo_<settings> | exposure_* | choice_*
   int views = 0;
   double psnr = 0, ssim = 0;
   double lpips = -1;  // -1: no LPIPS function given
@@ -48,11 +51,16 @@ struct NamedChoiceModel {
 
 // The validation views of Trainer::Validate (ValidationTargets with `holdout_targets`,
 // top-K sources by overlap, full packed size), one row per scene and method, then the
-// means over all views (scene "all").
-std::vector<HeadroomRow> MeasureHeadroom(
-    const std::vector<PackedScene>& scenes, int num_sources, int views_per_scene,
-    const SampleWarpOptions& warp, const ImageDistance& lpips,
-    bool holdout_targets = false, const std::vector<NamedChoiceModel>& choice = {});
+// means over all views (scene "all"). `methods`: comma-separated prefixes of the method
+// names to measure (e.g. "ulr,stereo"); empty = all. Throws fvs::Error when it selects
+// none.
+std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
+                                         int num_sources, int views_per_scene,
+                                         const SampleWarpOptions& warp,
+                                         const ImageDistance& lpips,
+                                         bool holdout_targets = false,
+                                         const std::vector<NamedChoiceModel>& choice = {},
+                                         const std::string& methods = "");
 
 // Writes the rows as CSV (scene,method,views,psnr,ssim,lpips), atomically.
 void WriteHeadroomCsv(const std::string& path, const std::vector<HeadroomRow>& rows);

@@ -182,6 +182,9 @@ void AddTrainOptions(OptionManager* options, TrainOptions* o) {
                       "with --Train.headroom: per-pixel choice models fitted on the "
                       "--scene_list targets, as rows: HIDDEN:l1|l2:all|local,... "
                       "(e.g. 0:l1:all,16:l2:local)");
+  options->AddDefault("Train.headroom_methods", &o->headroom_methods,
+                      "with --Train.headroom: only the methods whose names start with "
+                      "one of these comma-separated prefixes (empty = all)");
   options->AddDefault(
       "Train.benchmark", &o->benchmark,
       "only the render benchmark: validation views of --val_scene_list rendered at "

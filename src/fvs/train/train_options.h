@@ -75,6 +75,9 @@ struct TrainOptions {
   // HIDDEN:LOSS:CHANNELS, LOSS l1 or l2, CHANNELS all or local (e.g.
   // "0:l1:all,16:l2:local"); empty: none.
   std::string headroom_choice;
+  // With headroom: only the methods whose names start with one of these comma-separated
+  // prefixes (e.g. "ulr,oracle_patch8,stereo"); empty = all.
+  std::string headroom_methods;
   // Only the trainer-only render benchmark (train/render_benchmark.h): renders
   // validation views of --val_scene_list with the network (--Train.init_weights, else a
   // fresh --Train.variant: timing only) and ulr, into M/render_benchmark.csv; no

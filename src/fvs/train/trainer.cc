@@ -620,7 +620,8 @@ TrainSummary RunHeadroom(const TrainOptions& options) {
   }
   const std::vector<HeadroomRow> rows = MeasureHeadroom(
       LoadScenes(options.val_scene_list, 2, options.num_sources), options.num_sources,
-      options.val_views, warp, distance, options.holdout_targets, choice);
+      options.val_views, warp, distance, options.holdout_targets, choice,
+      options.headroom_methods);
   std::filesystem::create_directories(options.output_path);
   WriteHeadroomCsv(options.output_path + "/headroom.csv", rows);
   for (const HeadroomRow& r : rows) {
