@@ -44,6 +44,37 @@ const char kTinyNetNoSkip[] =
         "encoder_convs": [1, 1, 1], "blend_channels": [8, 16, 16], "blend_convs_per_stage": 2,
         "rgb_skip": false, "mask_prior": 0, "ulr_prior": 0})";
 
+// The depth refinements' case: view 2 of `scene` with its own proxy scaled by `factor`
+// (only the target's: an occlusion tolerance that still lets its sources see it; in a
+// real workspace the target's and the sources' depths come from one mesh), its top-3
+// sources, its `ulr` blend and the pixels a refinement may move.
+struct DepthCase {
+  PackedScene scene;
+  SampleWarpOptions warp;
+  TrainingSample sample;
+  torch::Tensor ulr, refinable;
+};
+
+DepthCase MakeDepthCase(const PackedScene& scene, float factor) {
+  DepthCase c;
+  c.scene = scene;
+  c.scene.depths = scene.depths.clone();
+  c.scene.depths[2].mul_(factor);
+  c.warp.ulr_log_weights = true;
+  c.warp.geometry.occlusion_tolerance = 0.05;
+  c.sample = MakeSample(c.scene, 2, SelectTrainingSources(scene, 2, 3), 0, 0,
+                        scene.width(), scene.height(), c.warp);
+  const TrainingSample& s = c.sample;
+  const torch::Tensor colours = (WarpFeatures(s.source_rgb, s.warp.grid) + 1) * 0.5;
+  c.ulr = BlendSeen(colours, s.warp.valid_warp, s.warp.ulr_log_weights);
+  c.refinable = Refinable(s);
+  return c;
+}
+
+double PsnrOf(const torch::Tensor& a, const torch::Tensor& b) {
+  return -10 * std::log10((a - b).pow(2).mean().item<double>());
+}
+
 class TrainerTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -259,43 +290,27 @@ TEST(ChoiceSpecs, ParseAndNameOrRefuseInOneLine) {
 TEST_F(TrainerTest, DepthSweepFindsTheDepthWhereTheSourcesAgree) {
   torch::set_num_threads(1);
   const PackedScene scene = LoadPackedScene(dir_->path() + "/scene_a");
-  SampleWarpOptions warp;
-  warp.ulr_log_weights = true;
-  // Only the target's proxy is moved below: a tolerance that still lets its sources see
-  // it (in a real workspace the target's and the sources' depths come from one mesh).
-  warp.geometry.occlusion_tolerance = 0.05;
-  const std::vector<int> sources = SelectTrainingSources(scene, 2, 3);
-  const auto psnr = [](const torch::Tensor& a, const torch::Tensor& b) {
-    return -10 * std::log10((a - b).pow(2).mean().item<double>());
-  };
-  const auto ulr_of = [](const TrainingSample& s) {
-    const torch::Tensor colours = (WarpFeatures(s.source_rgb, s.warp.grid) + 1) * 0.5;
-    return BlendSeen(colours, s.warp.valid_warp, s.warp.ulr_log_weights);
-  };
   DepthSweepOptions options;
   options.radius = 1;
   torch::Tensor chosen;
-  const TrainingSample exact =
-      MakeSample(scene, 2, sources, 0, 0, scene.width(), scene.height(), warp);
-  const torch::Tensor kept = DepthSweepBlend(scene, exact, warp, options, &chosen);
+  const DepthCase exact = MakeDepthCase(scene, 1.0f);
+  const torch::Tensor kept =
+      DepthSweepBlend(exact.scene, exact.sample, exact.warp, options, &chosen);
   EXPECT_TRUE(torch::isfinite(kept).all().item<bool>());
-  EXPECT_GE(psnr(kept, exact.target_rgb), psnr(ulr_of(exact), exact.target_rgb) - 0.5);
+  EXPECT_GE(PsnrOf(kept, exact.sample.target_rgb),
+            PsnrOf(exact.ulr, exact.sample.target_rgb) - 0.5);
 
-  PackedScene off = scene;
-  off.depths = scene.depths.clone();
-  off.depths[2].mul_(1.03f);
-  const TrainingSample s =
-      MakeSample(off, 2, sources, 0, 0, off.width(), off.height(), warp);
-  const torch::Tensor swept = DepthSweepBlend(off, s, warp, options, &chosen);
-  const torch::Tensor sweepable =
-      (s.warp.valid_warp.sum(0, true) >= 2) & (s.warp.valid_depth > 0);
-  ASSERT_GT(sweepable.sum().item<int64_t>(), 200);
-  EXPECT_NEAR(chosen.masked_select(sweepable).median().item<double>(), -0.03, 0.011);
+  const DepthCase off = MakeDepthCase(scene, 1.03f);
+  const torch::Tensor swept =
+      DepthSweepBlend(off.scene, off.sample, off.warp, options, &chosen);
+  ASSERT_GT(off.refinable.sum().item<int64_t>(), 200);
+  EXPECT_NEAR(chosen.masked_select(off.refinable).median().item<double>(), -0.03, 0.011);
   // Measured: 32.96 against 32.74 dB (34.45 with the true proxy).
-  EXPECT_GT(psnr(swept, s.target_rgb), psnr(ulr_of(s), s.target_rgb) + 0.1);
+  EXPECT_GT(PsnrOf(swept, off.sample.target_rgb),
+            PsnrOf(off.ulr, off.sample.target_rgb) + 0.1);
 
   options.steps = 0;
-  EXPECT_THROW(DepthSweepBlend(off, s, warp, options), Error);
+  EXPECT_THROW(DepthSweepBlend(off.scene, off.sample, off.warp, options), Error);
 }
 
 // Semi-global matching (train/depth_stereo.h): without penalties it is the cost summed
@@ -324,21 +339,7 @@ TEST(DepthStereoTest, SemiGlobalMatchingSmoothsLoneChoicesAndKeepsRegions) {
 // the wrong proxy; bad options are refused.
 TEST_F(TrainerTest, DepthStereoFindsTheDepthWhereTheSourcesCorrelate) {
   torch::set_num_threads(1);
-  const PackedScene scene = LoadPackedScene(dir_->path() + "/scene_a");
-  SampleWarpOptions warp;
-  warp.ulr_log_weights = true;
-  warp.geometry.occlusion_tolerance = 0.05;
-  const std::vector<int> sources = SelectTrainingSources(scene, 2, 3);
-  const auto psnr = [](const torch::Tensor& a, const torch::Tensor& b) {
-    return -10 * std::log10((a - b).pow(2).mean().item<double>());
-  };
-  PackedScene off = scene;
-  off.depths = scene.depths.clone();
-  off.depths[2].mul_(1.03f);
-  const TrainingSample s =
-      MakeSample(off, 2, sources, 0, 0, off.width(), off.height(), warp);
-  const torch::Tensor colours = (WarpFeatures(s.source_rgb, s.warp.grid) + 1) * 0.5;
-  const torch::Tensor ulr = BlendSeen(colours, s.warp.valid_warp, s.warp.ulr_log_weights);
+  const DepthCase off = MakeDepthCase(LoadPackedScene(dir_->path() + "/scene_a"), 1.03f);
   DepthStereoOptions options;
   options.radius = 2;
   // This smooth texture correlates almost as well at every depth: no pull toward the
@@ -346,16 +347,16 @@ TEST_F(TrainerTest, DepthStereoFindsTheDepthWhereTheSourcesCorrelate) {
   options.prior = 0;
   options.absolute_weight = 0.5;
   torch::Tensor chosen;
-  const torch::Tensor refined = DepthStereoBlend(off, s, warp, options, &chosen);
+  const torch::Tensor refined =
+      DepthStereoBlend(off.scene, off.sample, off.warp, options, &chosen);
   EXPECT_TRUE(torch::isfinite(refined).all().item<bool>());
-  const torch::Tensor sweepable =
-      (s.warp.valid_warp.sum(0, true) >= 2) & (s.warp.valid_depth > 0);
-  ASSERT_GT(sweepable.sum().item<int64_t>(), 200);
-  EXPECT_NEAR(chosen.masked_select(sweepable).median().item<double>(), -0.03, 0.008);
+  ASSERT_GT(off.refinable.sum().item<int64_t>(), 200);
+  EXPECT_NEAR(chosen.masked_select(off.refinable).median().item<double>(), -0.03, 0.008);
   // Measured: 32.97 against 32.74 dB.
-  EXPECT_GT(psnr(refined, s.target_rgb), psnr(ulr, s.target_rgb) + 0.1);
+  EXPECT_GT(PsnrOf(refined, off.sample.target_rgb),
+            PsnrOf(off.ulr, off.sample.target_rgb) + 0.1);
   options.p2 = options.p1 / 2;
-  EXPECT_THROW(DepthStereoBlend(off, s, warp, options), Error);
+  EXPECT_THROW(DepthStereoBlend(off.scene, off.sample, off.warp, options), Error);
 }
 
 TEST_F(TrainerTest, SsimIsOneForEqualImagesAndLowerOtherwise) {

@@ -8,6 +8,7 @@
 
 #include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
+#include "fvs/train/depth_sweep.h"
 #include "fvs/util/error.h"
 
 namespace fvs {
@@ -119,40 +120,22 @@ torch::Tensor DepthStereoBlend(const PackedScene& scene, const TrainingSample& s
                                const SampleWarpOptions& settings,
                                const DepthStereoOptions& options, torch::Tensor* chosen) {
   options.Check();
-  Require(s.warp.ulr_log_weights.defined(), "DepthStereoBlend",
-          "the sample has no ULR log-weights");
+  GridAtScaledDepth(scene, s, settings, 0);  // checks the sample
   torch::NoGradGuard no_grad;
   const torch::Tensor& seen = s.warp.valid_warp;  // [K,1,h,w]
   const int64_t h = seen.size(2), w = seen.size(3);
-  Require(h == scene.height() && w == scene.width(), "DepthStereoBlend",
-          "needs a full-size sample");
   // Normalised ULR weights among the seeing sources, fixed over the sweep; the reference
   // of each pixel is its heaviest seeing source.
   const torch::Tensor weights = SeenWeights(s.warp.ulr_log_weights, seen);
   const torch::Tensor reference = weights.argmax(0, true);  // [1,1,h,w]
   const torch::Tensor others =
       seen * (torch::arange(seen.size(0)).view({-1, 1, 1, 1}) != reference);
-  const torch::Tensor sweepable = (seen.sum(0, true) >= 2) & (s.warp.valid_depth > 0);
-
-  const torch::Tensor idx = torch::tensor(
-      std::vector<int64_t>(s.sources.begin(), s.sources.end()), torch::kLong);
-  const torch::Tensor source_K = scene.K.index_select(0, idx);
-  const torch::Tensor source_R = scene.R.index_select(0, idx);
-  const torch::Tensor source_t = scene.t.index_select(0, idx);
-  const torch::Tensor source_depths = scene.depths.index_select(0, idx);
-  SampleWarpOptions geometry_only = settings;
-  geometry_only.ulr_log_weights = false;
+  const torch::Tensor sweepable = Refinable(s);
 
   std::vector<torch::Tensor> blends, costs;
   for (int i = -options.steps; i <= options.steps; ++i) {
     const double change = options.max_relative * i / options.steps;
-    const torch::Tensor grid =
-        i == 0
-            ? s.warp.grid
-            : ComputeTrainingWarp(scene.K[s.target], scene.R[s.target], scene.t[s.target],
-                                  scene.depths[s.target] * (1 + change), source_K,
-                                  source_R, source_t, source_depths, geometry_only)
-                  .grid;
+    const torch::Tensor grid = GridAtScaledDepth(scene, s, settings, change);
     const torch::Tensor in_frame =
         (grid.abs() <= 1).all(-1).unsqueeze(1).to(torch::kFloat);  // [K,1,h,w]
     const torch::Tensor colours =

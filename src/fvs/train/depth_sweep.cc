@@ -20,42 +20,48 @@ void DepthSweepOptions::Check() const {
           "DepthSweepOptions", "prior and relative_prior must be finite and >= 0");
 }
 
+torch::Tensor GridAtScaledDepth(const PackedScene& scene, const TrainingSample& s,
+                                const SampleWarpOptions& settings, double change) {
+  Require(s.warp.ulr_log_weights.defined(), "depth refinement",
+          "the sample has no ULR log-weights");
+  Require(s.warp.valid_warp.size(2) == scene.height() &&
+              s.warp.valid_warp.size(3) == scene.width(),
+          "depth refinement", "needs a full-size sample");
+  if (change == 0) return s.warp.grid;
+  const torch::Tensor idx = torch::tensor(
+      std::vector<int64_t>(s.sources.begin(), s.sources.end()), torch::kLong);
+  SampleWarpOptions geometry_only = settings;
+  geometry_only.ulr_log_weights = false;
+  return ComputeTrainingWarp(scene.K[s.target], scene.R[s.target], scene.t[s.target],
+                             scene.depths[s.target] * (1 + change),
+                             scene.K.index_select(0, idx), scene.R.index_select(0, idx),
+                             scene.t.index_select(0, idx),
+                             scene.depths.index_select(0, idx), geometry_only)
+      .grid;
+}
+
+torch::Tensor Refinable(const TrainingSample& s) {
+  return (s.warp.valid_warp.sum(0, true) >= 2) & (s.warp.valid_depth > 0);
+}
+
 torch::Tensor DepthSweepBlend(const PackedScene& scene, const TrainingSample& s,
                               const SampleWarpOptions& settings,
                               const DepthSweepOptions& options, torch::Tensor* chosen) {
   options.Check();
-  Require(s.warp.ulr_log_weights.defined(), "DepthSweepBlend",
-          "the sample has no ULR log-weights");
+  GridAtScaledDepth(scene, s, settings, 0);  // checks the sample
   torch::NoGradGuard no_grad;
   const torch::Tensor& seen = s.warp.valid_warp;  // [K,1,h,w]
   const int64_t h = seen.size(2), w = seen.size(3);
-  Require(h == scene.height() && w == scene.width(), "DepthSweepBlend",
-          "needs a full-size sample");
   // Normalised ULR weights among the seeing sources, fixed over the sweep.
   const torch::Tensor weights = SeenWeights(s.warp.ulr_log_weights, seen);
-  const torch::Tensor sweepable = (seen.sum(0, true) >= 2) & (s.warp.valid_depth > 0);
-
-  const torch::Tensor idx = torch::tensor(
-      std::vector<int64_t>(s.sources.begin(), s.sources.end()), torch::kLong);
-  const torch::Tensor source_K = scene.K.index_select(0, idx);
-  const torch::Tensor source_R = scene.R.index_select(0, idx);
-  const torch::Tensor source_t = scene.t.index_select(0, idx);
-  const torch::Tensor source_depths = scene.depths.index_select(0, idx);
-  SampleWarpOptions geometry_only = settings;
-  geometry_only.ulr_log_weights = false;
+  const torch::Tensor sweepable = Refinable(s);
 
   torch::Tensor best_cost =
       torch::full({1, 1, h, w}, std::numeric_limits<float>::infinity());
   torch::Tensor best_blend, best_change = torch::zeros({1, 1, h, w});
   for (int i = -options.steps; i <= options.steps; ++i) {
     const double change = options.max_relative * i / options.steps;
-    const torch::Tensor grid =
-        i == 0
-            ? s.warp.grid
-            : ComputeTrainingWarp(scene.K[s.target], scene.R[s.target], scene.t[s.target],
-                                  scene.depths[s.target] * (1 + change), source_K,
-                                  source_R, source_t, source_depths, geometry_only)
-                  .grid;
+    const torch::Tensor grid = GridAtScaledDepth(scene, s, settings, change);
     const torch::Tensor colours =
         torch::nan_to_num((WarpFeatures(s.source_rgb, grid) + 1) * 0.5, 0, 0, 0);
     const torch::Tensor blend = (weights * colours).sum(0, true);  // [1,3,h,w]

@@ -37,4 +37,13 @@ torch::Tensor DepthSweepBlend(const PackedScene& scene, const TrainingSample& s,
                               const DepthSweepOptions& options,
                               torch::Tensor* chosen = nullptr);
 
+// What the sweep and the stereo (train/depth_stereo.h) share. The grid [K,h,w,2] of the
+// sample's sources at its target's proxy depth x (1 + change) (change 0: the sample's own
+// grid); throws fvs::Error unless `s` is a full-size sample with ULR log-weights.
+torch::Tensor GridAtScaledDepth(const PackedScene& scene, const TrainingSample& s,
+                                const SampleWarpOptions& settings, double change);
+// The pixels a refinement may move [1,1,h,w] (bool): a surface seen by two sources or
+// more.
+torch::Tensor Refinable(const TrainingSample& s);
+
 }  // namespace fvs
