@@ -47,7 +47,8 @@ torch::Tensor Luminance(const torch::Tensor& colours) { return colours.mean(1, t
 
 // 1 - the normalised cross-correlation of each source's luminance `b` [K,1,h,w] with the
 // reference's `a` [1,1,h,w] over the window, over the pixels both have (`valid`
-// [K,1,h,w]); 1 where either window is flatter than `min_texture` or nothing is valid.
+// [K,1,h,w]); 1 where either window is flatter than `min_texture` or less than half of
+// it is valid. Plus `absolute_weight` x the window's mean |a - b| / 0.1.
 torch::Tensor CorrelationCost(const torch::Tensor& a, const torch::Tensor& b,
                               const torch::Tensor& valid, int radius, double min_texture,
                               double absolute_weight) {
