@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 
@@ -46,6 +47,16 @@ fvs::Image ReadImage(const std::string& path, int channels) {
   const OIIO::ImageSpec& spec = input->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1) {
     throw Error(path, "unsupported image (empty, or a volume)");
+  }
+  // A header may claim any size (a 81-byte PBM claimed 51 GB of pixels: image_fuzzer);
+  // refuse more than 2^29 values (2 GiB as floats: a 13 000 x 13 000 RGB photo) before
+  // allocating.
+  const int64_t values = static_cast<int64_t>(spec.width) * spec.height * spec.nchannels;
+  if (values > (int64_t{1} << 29)) {
+    throw Error(path, "image of " + std::to_string(spec.width) + "x" +
+                          std::to_string(spec.height) + " with " +
+                          std::to_string(spec.nchannels) +
+                          " channels is too large (over 2^29 values; corrupt header?)");
   }
   Image file(spec.width, spec.height, spec.nchannels);
   if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,
