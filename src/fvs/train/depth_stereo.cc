@@ -121,7 +121,7 @@ torch::Tensor DepthStereoBlend(const PackedScene& scene, const TrainingSample& s
                                const SampleWarpOptions& settings,
                                const DepthStereoOptions& options, torch::Tensor* chosen) {
   options.Check();
-  GridAtScaledDepth(scene, s, settings, 0);  // checks the sample
+  CheckRefinableSample(scene, s);
   torch::NoGradGuard no_grad;
   const torch::Tensor& seen = s.warp.valid_warp;  // [K,1,h,w]
   const int64_t h = seen.size(2), w = seen.size(3);

@@ -20,13 +20,17 @@ void DepthSweepOptions::Check() const {
           "DepthSweepOptions", "prior and relative_prior must be finite and >= 0");
 }
 
-torch::Tensor GridAtScaledDepth(const PackedScene& scene, const TrainingSample& s,
-                                const SampleWarpOptions& settings, double change) {
+void CheckRefinableSample(const PackedScene& scene, const TrainingSample& s) {
   Require(s.warp.ulr_log_weights.defined(), "depth refinement",
           "the sample has no ULR log-weights");
   Require(s.warp.valid_warp.size(2) == scene.height() &&
               s.warp.valid_warp.size(3) == scene.width(),
           "depth refinement", "needs a full-size sample");
+}
+
+torch::Tensor GridAtScaledDepth(const PackedScene& scene, const TrainingSample& s,
+                                const SampleWarpOptions& settings, double change) {
+  CheckRefinableSample(scene, s);
   if (change == 0) return s.warp.grid;
   const torch::Tensor idx = torch::tensor(
       std::vector<int64_t>(s.sources.begin(), s.sources.end()), torch::kLong);
@@ -48,7 +52,7 @@ torch::Tensor DepthSweepBlend(const PackedScene& scene, const TrainingSample& s,
                               const SampleWarpOptions& settings,
                               const DepthSweepOptions& options, torch::Tensor* chosen) {
   options.Check();
-  GridAtScaledDepth(scene, s, settings, 0);  // checks the sample
+  CheckRefinableSample(scene, s);
   torch::NoGradGuard no_grad;
   const torch::Tensor& seen = s.warp.valid_warp;  // [K,1,h,w]
   const int64_t h = seen.size(2), w = seen.size(3);

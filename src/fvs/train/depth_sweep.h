@@ -37,9 +37,11 @@ torch::Tensor DepthSweepBlend(const PackedScene& scene, const TrainingSample& s,
                               const DepthSweepOptions& options,
                               torch::Tensor* chosen = nullptr);
 
-// What the sweep and the stereo (train/depth_stereo.h) share. The grid [K,h,w,2] of the
-// sample's sources at its target's proxy depth x (1 + change) (change 0: the sample's own
-// grid); throws fvs::Error unless `s` is a full-size sample with ULR log-weights.
+// What the sweep and the stereo (train/depth_stereo.h) share. Throws fvs::Error unless
+// `s` is a full-size sample of `scene` with ULR log-weights.
+void CheckRefinableSample(const PackedScene& scene, const TrainingSample& s);
+// The grid [K,h,w,2] of the sample's sources at its target's proxy depth x (1 + change)
+// (change 0: the sample's own grid); checks the sample as above.
 torch::Tensor GridAtScaledDepth(const PackedScene& scene, const TrainingSample& s,
                                 const SampleWarpOptions& settings, double change);
 // The pixels a refinement may move [1,1,h,w] (bool): a surface seen by two sources or

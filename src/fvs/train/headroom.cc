@@ -255,14 +255,13 @@ std::vector<HeadroomRow> MeasureHeadroom(const std::vector<PackedScene>& scenes,
       add([&] {
         return ExposureMatchedBlend(colours, seen, s.warp.ulr_log_weights, true);
       });
-      if (!choice.empty()) {
-        const torch::Tensor evidence = SourceEvidence(scene, s, colours);
-        for (NamedChoiceModel c : choice) {  // a holder: a shared pointer
-          add([&] {
-            return BlendSeen(colours, seen,
-                             c.model->forward(evidence, s.warp.ulr_log_weights));
-          });
-        }
+      torch::Tensor evidence;  // for the choice rows; only when one is selected
+      for (NamedChoiceModel c : choice) {  // a holder: a shared pointer
+        add([&] {
+          if (!evidence.defined()) evidence = SourceEvidence(scene, s, colours);
+          return BlendSeen(colours, seen,
+                           c.model->forward(evidence, s.warp.ulr_log_weights));
+        });
       }
       for (int m = 0; m < kNum; ++m) {
         if (!images[m].defined()) continue;
