@@ -2,7 +2,10 @@
 // gets fvs::Error naming the file at fault, util/error.h). FVS_CHECK(condition, what)
 // throws fvs::Error("internal error at <file>:<line>", ...) when the condition fails, so
 // a broken invariant is still one line and a non-zero exit, never an abort, and the line
-// says where to look.
+// says where to look. <file> is the base name (__FILE_NAME__, GCC 12 and clang): __FILE__
+// would put the absolute path of the checkout into the binaries of any build that does not
+// go through ccache's base_dir rewriting, and installed binaries must not name the build
+// machine's folders (install_test).
 #pragma once
 
 #include <string>
@@ -19,6 +22,12 @@ namespace fvs::internal {
 
 }  // namespace fvs::internal
 
+#ifdef __FILE_NAME__
+#define FVS_CHECK_FILE_ __FILE_NAME__
+#else
+#define FVS_CHECK_FILE_ __FILE__
+#endif
+
 #define FVS_CHECK(condition, what)    \
   ((condition) ? static_cast<void>(0) \
-               : ::fvs::internal::CheckFailed(__FILE__, __LINE__, #condition, (what)))
+               : ::fvs::internal::CheckFailed(FVS_CHECK_FILE_, __LINE__, #condition, (what)))
