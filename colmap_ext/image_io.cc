@@ -18,6 +18,8 @@ namespace {
 
 namespace OIIO = OIIO_NAMESPACE;
 
+constexpr int64_t kMaxImageValues = int64_t{1} << 28;
+
 std::unique_ptr<OIIO::ImageInput> OpenInput(const std::string& path) {
   auto input = OIIO::ImageInput::open(path);
   if (!input) {
@@ -48,15 +50,17 @@ fvs::Image ReadImage(const std::string& path, int channels) {
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1) {
     throw Error(path, "unsupported image (empty, or a volume)");
   }
-  // A header may claim any size (a 81-byte PBM claimed 51 GB of pixels: image_fuzzer);
-  // refuse more than 2^29 values (2 GiB as floats: a 13 000 x 13 000 RGB photo) before
-  // allocating.
-  const int64_t values = static_cast<int64_t>(spec.width) * spec.height * spec.nchannels;
-  if (values > (int64_t{1} << 29)) {
+  // A header may claim any size (an 81-byte PBM claimed 51 GB of pixels, a 17-byte one
+  // 77 777 777 x 6 grey pixels that read as RGB made 5.6 GB: image_fuzzer). Refuse before
+  // allocating when the file's values or the result's exceed 2^28 (1 GiB of floats each:
+  // an 89-megapixel RGB photo), so a read never holds more than about 2 GiB.
+  const int64_t pixels = static_cast<int64_t>(spec.width) * spec.height;
+  const int64_t values = pixels * std::max(spec.nchannels, channels);
+  if (values > kMaxImageValues) {
     throw Error(path, "image of " + std::to_string(spec.width) + "x" +
                           std::to_string(spec.height) + " with " +
                           std::to_string(spec.nchannels) +
-                          " channels is too large (over 2^29 values; corrupt header?)");
+                          " channels is too large (over 2^28 values; corrupt header?)");
   }
   Image file(spec.width, spec.height, spec.nchannels);
   if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,

@@ -166,6 +166,12 @@ TEST(ImageIo, BadImagesAreNamed) {
   // PBM found by tests/fuzz/image_fuzzer).
   WriteTextFile(dir / "huge.pbm", "P4\n2000000000 6\n" + std::string(16, '\xff'));
   ExpectError([&] { ReadImage(dir / "huge.pbm"); }, {"huge.pbm", "too large"});
+  // What the result holds counts too: 100 million grey pixels fit the bound in the file
+  // but not as RGB (a 17-byte PBM of 77 777 777 x 6 made 5.6 GB so).
+  WriteTextFile(dir / "wide.pbm", "P4\n100000000 1\n" + std::string(16, '\xff'));
+  ExpectError([&] { ReadImage(dir / "wide.pbm", 3); }, {"wide.pbm", "too large"});
+  WriteTextFile(dir / "found.pbm", "P4\n077777777 6\n");
+  ExpectError([&] { ReadImage(dir / "found.pbm", 1); }, {"found.pbm", "too large"});
 }
 
 TEST(Workspace, PathsAndChecks) {
