@@ -12,7 +12,8 @@ namespace fvs::colmap {
 
 // Colours as float in [0, 1]. channels = 3 converts grey to RGB and drops alpha; 1
 // converts to grey (luma); 0 keeps the file's channels. Throws fvs::Error naming the
-// file.
+// file, also before allocating when the file's or the result's values would exceed 2^28
+// (an 89-megapixel RGB photo; larger claims are corrupt headers in practice).
 fvs::Image ReadImage(const std::string& path, int channels = 3);
 // Size without decoding the pixels.
 void ReadImageSize(const std::string& path, int* width, int* height);
