@@ -54,9 +54,9 @@ fvs::Image ReadImage(const std::string& path, int channels) {
   // 77 777 777 x 6 grey pixels that read as RGB made 5.6 GB: image_fuzzer). Refuse before
   // allocating when the file's values or the result's exceed 2^28 (1 GiB of floats each:
   // an 89-megapixel RGB photo), so a read never holds more than about 2 GiB.
+  // (Width times height fits 63 bits; times the channels might not, hence the division.)
   const int64_t pixels = static_cast<int64_t>(spec.width) * spec.height;
-  const int64_t values = pixels * std::max(spec.nchannels, channels);
-  if (values > kMaxImageValues) {
+  if (pixels > kMaxImageValues / std::max(spec.nchannels, channels)) {
     throw Error(path, "image of " + std::to_string(spec.width) + "x" +
                           std::to_string(spec.height) + " with " +
                           std::to_string(spec.nchannels) +
