@@ -19,6 +19,7 @@ namespace {
 namespace OIIO = OIIO_NAMESPACE;
 
 constexpr int64_t kMaxImageValues = int64_t{1} << 28;
+constexpr uint64_t kMaxScanlineBytes = uint64_t{1} << 20;
 
 std::unique_ptr<OIIO::ImageInput> OpenInput(const std::string& path) {
   auto input = OIIO::ImageInput::open(path);
@@ -61,6 +62,15 @@ fvs::Image ReadImage(const std::string& path, int channels) {
                           std::to_string(spec.height) + " with " +
                           std::to_string(spec.nchannels) +
                           " channels is too large (over 2^28 values; corrupt header?)");
+  }
+  // OpenImageIO converts to float in chunks of at least 256 scanlines whatever the height
+  // (a 26-byte PBM of 21 474 837 x 7 pixels made it allocate 5.5 GB: image_fuzzer), so a
+  // scanline of over 1 MiB in the file's own format (a 349 525-pixel-wide 8-bit RGB row)
+  // is refused too.
+  if (spec.scanline_bytes(true) > kMaxScanlineBytes) {
+    throw Error(path, "image of " + std::to_string(spec.width) + "x" +
+                          std::to_string(spec.height) +
+                          " is too wide (over 1 MiB per row; corrupt header?)");
   }
   Image file(spec.width, spec.height, spec.nchannels);
   if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,

@@ -172,6 +172,9 @@ TEST(ImageIo, BadImagesAreNamed) {
   ExpectError([&] { ReadImage(dir / "wide.pbm", 3); }, {"wide.pbm", "too large"});
   WriteTextFile(dir / "found.pbm", "P4\n077777777 6\n");
   ExpectError([&] { ReadImage(dir / "found.pbm", 1); }, {"found.pbm", "too large"});
+  // A row too wide for OpenImageIO's conversion chunk of 256 rows (5.5 GB).
+  WriteTextFile(dir / "wide_row.pbm", "P4\n21474837 7 21474836477");
+  ExpectError([&] { ReadImage(dir / "wide_row.pbm", 1); }, {"wide_row.pbm", "too wide"});
   // Width times height times channels past 2^63 (undefined behaviour in the first version
   // of the bound: image_fuzzer, 33 executions in).
   WriteTextFile(dir / "max.pbm", "P4\n2147483647 2147483647\n");

@@ -241,6 +241,7 @@ void ImageSeeds(const std::string& scratch) {
   Seed("image", "pbm_51gb",
        std::string(1, 5) + "P4\n066666666666 6\n" + std::string(16, '\x66'));
   Seed("image", "pbm_grey_as_rgb", std::string(1, 5) + "P4\n077777777 6\n");
+  Seed("image", "pbm_wide", std::string(1, 5) + "P4\n21474837 7 21474836477");
   Seed("image", "pbm_2_to_62_pixels", std::string(1, 5) + "P4\n2147483647 2147483647\n");
 }
 
