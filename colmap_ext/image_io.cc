@@ -20,6 +20,7 @@ namespace OIIO = OIIO_NAMESPACE;
 
 constexpr int64_t kMaxImageValues = int64_t{1} << 28;
 constexpr uint64_t kMaxScanlineBytes = uint64_t{1} << 20;
+constexpr int64_t kMaxTileValues = int64_t{1} << 24;
 
 std::unique_ptr<OIIO::ImageInput> OpenInput(const std::string& path) {
   auto input = OIIO::ImageInput::open(path);
@@ -71,6 +72,17 @@ fvs::Image ReadImage(const std::string& path, int channels) {
     throw Error(path, "image of " + std::to_string(spec.width) + "x" +
                           std::to_string(spec.height) +
                           " is too wide (over 1 MiB per row; corrupt header?)");
+  }
+  // Tiled files are converted a tile at a time (a TIFF claiming tiles of 65 536 x 65 536
+  // grey pixels made OpenImageIO allocate 17 GB): tiles over 2^24 values (a 2 048 x 2 048
+  // RGBA tile; real ones are 64 to 1 024 pixels square) are refused.
+  // (A volume's tiles are refused too: depth is 1, checked above.)
+  const int64_t tile_pixels = static_cast<int64_t>(spec.tile_width) * spec.tile_height;
+  if (spec.tile_width > 0 && (spec.tile_height <= 0 || spec.tile_depth > 1 ||
+                              tile_pixels > kMaxTileValues / spec.nchannels)) {
+    throw Error(path, "tiles of " + std::to_string(spec.tile_width) + "x" +
+                          std::to_string(spec.tile_height) +
+                          " pixels are too large (over 2^24 values; corrupt header?)");
   }
   Image file(spec.width, spec.height, spec.nchannels);
   if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,

@@ -13,6 +13,7 @@
 #include "colmap_ext/workspace.h"
 #include "fvs/util/error.h"
 #include "support/test_support.h"
+#include "support/tiled_tiff.h"
 
 namespace fvs::colmap {
 namespace {
@@ -175,6 +176,15 @@ TEST(ImageIo, BadImagesAreNamed) {
   // A row too wide for OpenImageIO's conversion chunk of 256 rows (5.5 GB).
   WriteTextFile(dir / "wide_row.pbm", "P4\n21474837 7 21474836477");
   ExpectError([&] { ReadImage(dir / "wide_row.pbm", 1); }, {"wide_row.pbm", "too wide"});
+  // Tiles claimed far larger than the image (OpenImageIO allocated a whole 65 536 x 65
+  // 536 tile, 17 GB); real tile sizes read.
+  WriteTextFile(dir / "tiles.tif", testing::TiledTiffBytes(65536));
+  ExpectError([&] { ReadImage(dir / "tiles.tif", 1); },
+              {"tiles.tif", "tiles of 65536x65536"});
+  WriteTextFile(dir / "tiles64.tif", testing::TiledTiffBytes(64));
+  const fvs::Image tiled = ReadImage(dir / "tiles64.tif", 1);
+  ASSERT_EQ(tiled.width, 64);
+  EXPECT_NEAR(tiled.data[64 * 64 - 1], 0x55 / 255.0, 1e-6);
   // Width times height times channels past 2^63 (undefined behaviour in the first version
   // of the bound: image_fuzzer, 33 executions in).
   WriteTextFile(dir / "max.pbm", "P4\n2147483647 2147483647\n");

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/tiled_tiff.h"
 #include "colmap_ext/camera_models.h"
 #include "colmap_ext/dense_io.h"
 #include "colmap_ext/image_io.h"
@@ -241,6 +242,9 @@ void ImageSeeds(const std::string& scratch) {
   Seed("image", "pbm_51gb",
        std::string(1, 5) + "P4\n066666666666 6\n" + std::string(16, '\x66'));
   Seed("image", "pbm_grey_as_rgb", std::string(1, 5) + "P4\n077777777 6\n");
+  Seed("image", "tiff_huge_tiles",
+       std::string(1, 2) + fvs::testing::TiledTiffBytes(65536));
+  Seed("image", "tiff_tiles", std::string(1, 2) + fvs::testing::TiledTiffBytes(64));
   Seed("image", "pbm_wide", std::string(1, 5) + "P4\n21474837 7 21474836477");
   Seed("image", "pbm_2_to_62_pixels", std::string(1, 5) + "P4\n2147483647 2147483647\n");
 }
