@@ -41,17 +41,9 @@ std::string Extension(const std::string& path) {
   return ext;
 }
 
-}  // namespace
-
-fvs::Image ReadImage(const std::string& path, int channels) {
-  if (channels != 0 && channels != 1 && channels != 3) {
-    throw Error(path, "ReadImage: channels must be 0, 1 or 3");
-  }
-  auto input = OpenInput(path);
-  const OIIO::ImageSpec& spec = input->spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1) {
-    throw Error(path, "unsupported image (empty, or a volume)");
-  }
+// The pixels a header claims, before anything is allocated for them.
+void CheckClaimedSize(const std::string& path, const OIIO::ImageSpec& spec,
+                      int channels) {
   // A header may claim any size (an 81-byte PBM claimed 51 GB of pixels, a 17-byte one
   // 77 777 777 x 6 grey pixels that read as RGB made 5.6 GB: image_fuzzer). Refuse before
   // allocating when the file's values or the result's exceed 2^28 (1 GiB of floats each:
@@ -76,7 +68,6 @@ fvs::Image ReadImage(const std::string& path, int channels) {
   // Tiled files are converted a tile at a time (a TIFF claiming tiles of 65 536 x 65 536
   // grey pixels made OpenImageIO allocate 17 GB): tiles over 2^24 values (a 2 048 x 2 048
   // RGBA tile; real ones are 64 to 1 024 pixels square) are refused.
-  // (A volume's tiles are refused too: depth is 1, checked above.)
   const int64_t tile_pixels = static_cast<int64_t>(spec.tile_width) * spec.tile_height;
   if (spec.tile_width > 0 && (spec.tile_height <= 0 || spec.tile_depth > 1 ||
                               tile_pixels > kMaxTileValues / spec.nchannels)) {
@@ -84,11 +75,51 @@ fvs::Image ReadImage(const std::string& path, int channels) {
                           std::to_string(spec.tile_height) +
                           " pixels are too large (over 2^24 values; corrupt header?)");
   }
-  Image file(spec.width, spec.height, spec.nchannels);
-  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,
-                         file.data.data())) {
-    throw Error(path, "cannot decode image (" + input->geterror() + ")");
+}
+
+// Decodes band by band into a buffer that grows with what was decoded: the capacity is
+// only reserved (address space), and each band is zero-filled just before it is read, so
+// a header claiming far more pixels than the file holds costs one band, not the claim (a
+// 69-byte PBM claiming 21 473 x 6 836 pixels spent 7 s filling 590 MB: image_fuzzer).
+// Bands are 256 scanlines, OpenImageIO's own conversion chunk, or one row of tiles.
+fvs::Image DecodeInBands(OIIO::ImageInput& input, const std::string& path) {
+  const OIIO::ImageSpec spec = input.spec();
+  fvs::Image file;
+  file.width = spec.width;
+  file.height = spec.height;
+  file.channels = spec.nchannels;
+  const size_t row_values = static_cast<size_t>(spec.width) * spec.nchannels;
+  file.data.reserve(row_values * spec.height);
+  const bool tiled = spec.tile_width > 0;
+  const int band = tiled ? spec.tile_height : 256;
+  for (int y0 = 0; y0 < spec.height; y0 += band) {
+    const int y1 = std::min(spec.height, y0 + band);
+    file.data.resize(row_values * y1);
+    float* rows = file.data.data() + row_values * y0;
+    const bool ok =
+        tiled ? input.read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + y0,
+                                 spec.y + y1, spec.z, spec.z + 1, 0, spec.nchannels,
+                                 OIIO::TypeDesc::FLOAT, rows)
+              : input.read_scanlines(0, 0, spec.y + y0, spec.y + y1, spec.z, 0,
+                                     spec.nchannels, OIIO::TypeDesc::FLOAT, rows);
+    if (!ok) throw Error(path, "cannot decode image (" + input.geterror() + ")");
   }
+  return file;
+}
+
+}  // namespace
+
+fvs::Image ReadImage(const std::string& path, int channels) {
+  if (channels != 0 && channels != 1 && channels != 3) {
+    throw Error(path, "ReadImage: channels must be 0, 1 or 3");
+  }
+  auto input = OpenInput(path);
+  const OIIO::ImageSpec& spec = input->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1) {
+    throw Error(path, "unsupported image (empty, or a volume)");
+  }
+  CheckClaimedSize(path, spec, channels);
+  Image file = DecodeInBands(*input, path);
   input->close();
   for (float& v : file.data) {
     if (!std::isfinite(v)) v = 0.0f;  // no NaN/Inf leaves a stage
