@@ -149,6 +149,28 @@ TEST(ImageIo, PngRoundTripsAndConversions) {
   }
 }
 
+// Decoding goes band by band (at most 2^22 values each): an image of several bands, 8 and
+// 16 bits, reads back exactly, rows in their places.
+TEST(ImageIo, ImagesOfSeveralBandsReadBack) {
+  TempDir dir;
+  fvs::Image rgb(2048, 700, 3);  // 4.3 million values: two bands
+  for (int y = 0; y < rgb.height; ++y) {
+    for (int x = 0; x < rgb.width; ++x) {
+      for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = ((x + 7 * y + 50 * c) % 256) / 255.0f;
+    }
+  }
+  for (const int bits : {8, 16}) {
+    WriteImage(dir / "big.png", rgb, bits);
+    const fvs::Image back = ReadImage(dir / "big.png");
+    ASSERT_EQ(back.data.size(), rgb.data.size());
+    float worst = 0.0f;
+    for (size_t i = 0; i < rgb.data.size(); ++i) {
+      worst = std::max(worst, std::abs(back.data[i] - rgb.data[i]));
+    }
+    EXPECT_LT(worst, 1e-6f) << bits << " bits";
+  }
+}
+
 TEST(ImageIo, BadImagesAreNamed) {
   TempDir dir;
   WriteTextFile(dir / "x.png", "not a png at all");
