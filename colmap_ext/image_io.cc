@@ -57,8 +57,9 @@ void CheckClaimedSize(const std::string& path, const OIIO::ImageSpec& spec,
                           std::to_string(spec.nchannels) +
                           " channels is too large (over 2^28 values; corrupt header?)");
   }
-  // OpenImageIO converts to float in chunks of at least 256 scanlines whatever the height
-  // (a 26-byte PBM of 21 474 837 x 7 pixels made it allocate 5.5 GB: image_fuzzer), so a
+  // A band is at least one row, and OpenImageIO's read_scanlines (still used for files
+  // with a type per channel) converts at least 256 rows per call whatever the height (a
+  // 26-byte PBM of 21 474 837 x 7 pixels made it allocate 5.5 GB: image_fuzzer), so a
   // scanline of over 1 MiB in the file's own format (a 349 525-pixel-wide 8-bit RGB row)
   // is refused too.
   if (spec.scanline_bytes(true) > kMaxScanlineBytes) {

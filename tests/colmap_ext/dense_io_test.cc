@@ -198,8 +198,8 @@ TEST(ImageIo, BadImagesAreNamed) {
   // A row too wide for OpenImageIO's conversion chunk of 256 rows (5.5 GB).
   WriteTextFile(dir / "wide_row.pbm", "P4\n21474837 7 21474836477");
   ExpectError([&] { ReadImage(dir / "wide_row.pbm", 1); }, {"wide_row.pbm", "too wide"});
-  // Tiles claimed far larger than the image (OpenImageIO allocated a whole 65 536 x 65
-  // 536 tile, 17 GB); real tile sizes read.
+  // Tiles claimed far larger than the image (OpenImageIO allocated a whole tile of
+  // 65 536 x 65 536 pixels, 17 GB); real tile sizes read.
   WriteTextFile(dir / "tiles.tif", testing::TiledTiffBytes(65536));
   ExpectError([&] { ReadImage(dir / "tiles.tif", 1); },
               {"tiles.tif", "tiles of 65536x65536"});

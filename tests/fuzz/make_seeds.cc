@@ -237,8 +237,8 @@ void ImageSeeds(const std::string& scratch) {
     }
     Seed("image", image.name, std::string(1, image.selector) + Slurp(path));
   }
-  // The headers image_fuzzer found claiming absurd sizes (a9d699d, then the result's
-  // channels counted too), as .ppm (selector 5): the CI smoke step runs them.
+  // The headers image_fuzzer found claiming absurd sizes (doc/reliability.md, findings),
+  // as .ppm (selector 5) or .tif (selector 2): the CI smoke step runs them.
   Seed("image", "pbm_51gb",
        std::string(1, 5) + "P4\n066666666666 6\n" + std::string(16, '\x66'));
   Seed("image", "pbm_grey_as_rgb", std::string(1, 5) + "P4\n077777777 6\n");
