@@ -47,8 +47,9 @@ void CheckClaimedSize(const std::string& path, const OIIO::ImageSpec& spec,
                       int channels) {
   // A header may claim any size (an 81-byte PBM claimed 51 GB of pixels, a 17-byte one
   // 77 777 777 x 6 grey pixels that read as RGB made 5.6 GB: image_fuzzer). Refuse before
-  // allocating when the file's values or the result's exceed 2^28 (1 GiB of floats each:
-  // an 89-megapixel RGB photo), so a read never holds more than about 2 GiB.
+  // allocating when the file's values or the result's exceed 2^28 (an 89-megapixel RGB
+  // photo): a read holds at most 1 GiB of floats beside one band, and decodes at most
+  // 2^28 values whatever the file's compression.
   // (Width times height fits 63 bits; times the channels might not, hence the division.)
   const int64_t pixels = static_cast<int64_t>(spec.width) * spec.height;
   if (pixels > kMaxImageValues / std::max(spec.nchannels, channels)) {
@@ -79,23 +80,50 @@ void CheckClaimedSize(const std::string& path, const OIIO::ImageSpec& spec,
   }
 }
 
-// Decodes band by band into a buffer that grows with what was decoded: the capacity is
-// only reserved (address space), and each band is zero-filled just before it is read, so
-// a header claiming far more pixels than the file holds costs one band, not the claim (a
-// 69-byte PBM claiming 21 473 x 6 836 pixels spent 7 s filling 590 MB: image_fuzzer).
+float Finite(float v) { return std::isfinite(v) ? v : 0.0f; }  // no NaN/Inf leaves a stage
+
+// Pixels of `n` channels to `channels` (n itself when 0): alpha is dropped, grey is
+// replicated to RGB, RGB becomes grey by Rec. 601 luma.
+void ConvertChannels(const float* src, int n, size_t pixels, int channels, float* dst) {
+  if (channels == 0 || channels == n) {
+    for (size_t i = 0; i < pixels * n; ++i) dst[i] = Finite(src[i]);
+    return;
+  }
+  for (size_t i = 0; i < pixels; ++i, src += n) {
+    const float r = Finite(src[0]);
+    const float g = n < 3 ? r : Finite(src[1]);
+    const float b = n < 3 ? r : Finite(src[2]);
+    if (channels == 3) {
+      *dst++ = r;
+      *dst++ = g;
+      *dst++ = b;
+    } else {
+      *dst++ = n < 3 ? r : 0.299f * r + 0.587f * g + 0.114f * b;
+    }
+  }
+}
+
+// Decodes band by band, each band converted at once to the channels asked for, into a
+// result whose capacity is only reserved (address space) and grows with what was decoded.
+// So a read holds the result and one band: a header claiming far more pixels than the
+// file holds costs one band, not the claim (a 69-byte PBM claiming 21 473 x 6 836 pixels
+// spent 7 s filling 590 MB), and channels that are dropped are never all held (a 185-byte
+// TIFF of 8 x 65 293 pixels with 512 channels, which OpenImageIO decodes as zeros, held
+// 1 GiB of floats for a 6 MB RGB result: image_fuzzer).
 // A band holds at most 2^22 values (16 MiB as floats), or one row of tiles. Scanlines of
 // one sample type are read in the file's own format and converted here, as OpenImageIO's
 // read_scanlines does, but without its conversion buffer: that is 64 MiB per call
 // whatever the rows asked for (narrow images read band by band spent 17 s allocating it
 // under ASan: image_fuzzer).
-fvs::Image DecodeInBands(OIIO::ImageInput& input, const std::string& path) {
+fvs::Image DecodeInBands(OIIO::ImageInput& input, const std::string& path,
+                         int channels) {
   const OIIO::ImageSpec spec = input.spec();
-  fvs::Image file;
-  file.width = spec.width;
-  file.height = spec.height;
-  file.channels = spec.nchannels;
+  fvs::Image out;
+  out.width = spec.width;
+  out.height = spec.height;
+  out.channels = channels == 0 ? spec.nchannels : channels;
+  out.data.reserve(static_cast<size_t>(spec.width) * spec.height * out.channels);
   const size_t row_values = static_cast<size_t>(spec.width) * spec.nchannels;
-  file.data.reserve(row_values * spec.height);
   const bool tiled = spec.tile_width > 0;
   const bool native = !tiled && spec.channelformats.empty();
   const int band =
@@ -103,29 +131,34 @@ fvs::Image DecodeInBands(OIIO::ImageInput& input, const std::string& path) {
             : static_cast<int>(std::max<size_t>(
                   1, std::min<size_t>(spec.height, (size_t{1} << 22) / row_values)));
   std::vector<unsigned char> raw;  // one band in the file's format (native reads)
+  std::vector<float> rows;         // one band as floats, all of the file's channels
   for (int y0 = 0; y0 < spec.height; y0 += band) {
     const int y1 = std::min(spec.height, y0 + band);
-    file.data.resize(row_values * y1);
-    float* rows = file.data.data() + row_values * y0;
     const size_t values = row_values * (y1 - y0);
+    rows.resize(values);
     bool ok = false;
     if (native) {
       raw.resize(values * spec.format.size());
       ok = input.read_native_scanlines(0, 0, spec.y + y0, spec.y + y1, spec.z,
                                        raw.data()) &&
            OIIO::convert_pixel_values(spec.format, raw.data(), OIIO::TypeDesc::FLOAT,
-                                      rows, static_cast<int>(values));
+                                      rows.data(), static_cast<int>(values));
     } else if (tiled) {
       ok = input.read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + y0, spec.y + y1,
                             spec.z, spec.z + 1, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,
-                            rows);
+                            rows.data());
     } else {
       ok = input.read_scanlines(0, 0, spec.y + y0, spec.y + y1, spec.z, 0, spec.nchannels,
-                                OIIO::TypeDesc::FLOAT, rows);
+                                OIIO::TypeDesc::FLOAT, rows.data());
     }
     if (!ok) throw Error(path, "cannot decode image (" + input.geterror() + ")");
+    const size_t pixels = static_cast<size_t>(spec.width) * (y1 - y0);
+    const size_t done = out.data.size();
+    out.data.resize(done + pixels * out.channels);
+    ConvertChannels(rows.data(), spec.nchannels, pixels, channels,
+                    out.data.data() + done);
   }
-  return file;
+  return out;
 }
 
 }  // namespace
@@ -140,33 +173,9 @@ fvs::Image ReadImage(const std::string& path, int channels) {
     throw Error(path, "unsupported image (empty, or a volume)");
   }
   CheckClaimedSize(path, spec, channels);
-  Image file = DecodeInBands(*input, path);
+  Image image = DecodeInBands(*input, path, channels);
   input->close();
-  for (float& v : file.data) {
-    if (!std::isfinite(v)) v = 0.0f;  // no NaN/Inf leaves a stage
-  }
-  const int n = spec.nchannels;
-  if (channels == 0 || channels == n) return file;
-  // Alpha is dropped; grey images are replicated to RGB; RGB to grey by Rec. 601 luma.
-  Image out(spec.width, spec.height, channels);
-  const size_t num_pixels = static_cast<size_t>(spec.width) * spec.height;
-  for (size_t i = 0; i < num_pixels; ++i) {
-    const float* src = &file.data[i * n];
-    float rgb[3];
-    if (n < 3) {
-      rgb[0] = rgb[1] = rgb[2] = src[0];
-    } else {
-      rgb[0] = src[0];
-      rgb[1] = src[1];
-      rgb[2] = src[2];
-    }
-    if (channels == 3) {
-      for (int c = 0; c < 3; ++c) out.data[i * 3 + c] = rgb[c];
-    } else {
-      out.data[i] = n < 3 ? src[0] : 0.299f * rgb[0] + 0.587f * rgb[1] + 0.114f * rgb[2];
-    }
-  }
-  return out;
+  return image;
 }
 
 void ReadImageSize(const std::string& path, int* width, int* height) {

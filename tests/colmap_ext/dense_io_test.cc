@@ -171,6 +171,44 @@ TEST(ImageIo, ImagesOfSeveralBandsReadBack) {
   }
 }
 
+// Channels are converted band by band (a 185-byte TIFF of 512 channels held 1 GiB of
+// floats for its RGB result: image_fuzzer): every band must still get the right ones.
+TEST(ImageIo, ExtraChannelsAreDroppedInEveryBand) {
+  TempDir dir;
+  fvs::Image many(700, 700, 9);  // 4.4 million values: two bands
+  auto value = [](int x, int y, int c) { return ((x + 3 * y + 29 * c) % 256) / 255.0f; };
+  for (int y = 0; y < many.height; ++y) {
+    for (int x = 0; x < many.width; ++x) {
+      for (int c = 0; c < 9; ++c) many.at(x, y, c) = value(x, y, c);
+    }
+  }
+  WriteImage(dir / "many.tif", many);
+  const fvs::Image all = ReadImage(dir / "many.tif", 0);
+  const fvs::Image rgb = ReadImage(dir / "many.tif", 3);
+  const fvs::Image grey = ReadImage(dir / "many.tif", 1);
+  ASSERT_EQ(all.channels, 9);
+  ASSERT_EQ(all.data.size(), many.data.size());
+  ASSERT_EQ(rgb.channels, 3);
+  ASSERT_EQ(rgb.data.size(), size_t{700} * 700 * 3);
+  ASSERT_EQ(grey.channels, 1);
+  ASSERT_EQ(grey.data.size(), size_t{700} * 700);
+  float worst = 0.0f;
+  for (int y = 0; y < many.height; ++y) {
+    for (int x = 0; x < many.width; ++x) {
+      for (int c = 0; c < 9; ++c) {
+        worst = std::max(worst, std::abs(all.at(x, y, c) - value(x, y, c)));
+      }
+      for (int c = 0; c < 3; ++c) {
+        worst = std::max(worst, std::abs(rgb.at(x, y, c) - value(x, y, c)));
+      }
+      const float luma =
+          0.299f * value(x, y, 0) + 0.587f * value(x, y, 1) + 0.114f * value(x, y, 2);
+      worst = std::max(worst, std::abs(grey.at(x, y) - luma));
+    }
+  }
+  EXPECT_LT(worst, 1e-6f);
+}
+
 TEST(ImageIo, BadImagesAreNamed) {
   TempDir dir;
   WriteTextFile(dir / "x.png", "not a png at all");

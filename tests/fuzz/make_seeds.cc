@@ -212,6 +212,14 @@ void ManifestSeeds(const std::string& scratch) {
   Seed("manifest", "manifest", Slurp(root + "/manifest.json"));
 }
 
+std::string FromHex(const std::string& hex) {
+  std::string bytes;
+  for (size_t i = 0; i + 1 < hex.size(); i += 2) {
+    bytes += static_cast<char>(std::stoi(hex.substr(i, 2), nullptr, 16));
+  }
+  return bytes;
+}
+
 void ImageSeeds(const std::string& scratch) {
   fvs::Image rgb(8, 6, 3);
   for (size_t i = 0; i < rgb.data.size(); ++i) rgb.data[i] = (i % 17) / 16.0f;
@@ -247,6 +255,17 @@ void ImageSeeds(const std::string& scratch) {
   Seed("image", "tiff_tiles", std::string(1, 2) + fvs::testing::TiledTiffBytes(64));
   Seed("image", "pbm_wide", std::string(1, 5) + "P4\n21474837 7 21474836477");
   Seed("image", "pbm_2_to_62_pixels", std::string(1, 5) + "P4\n2147483647 2147483647\n");
+  // 185 bytes that OpenImageIO decodes as 8 x 65 293 pixels of 512 channels (zeros where
+  // the strips are missing): read as RGB it held 1 GiB of floats before the channels were
+  // converted band by band.
+  Seed("image", "tiff_512_channels",
+       std::string(1, 2) +
+           FromHex("49492a00080000000e0000010300010000000800000001010300010000000dffffffffff"
+                   "ffffff000000b6005a420300030001000000080000000601030001000000055034323137"
+                   "333837203634362037950a01030001000000080000000601030001000000020000001101"
+                   "040001000000d60000000b01030001000000010000001501030001000000000200000016"
+                   "0103000100000020000000170104000100000000003d32333a33351c1c1c1c1c1c1c1c1c"
+                   "1c1c1c0335"));
 }
 
 // An SQL blob literal of little-endian doubles (COLMAP's camera parameters).
