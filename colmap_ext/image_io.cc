@@ -80,7 +80,8 @@ void CheckClaimedSize(const std::string& path, const OIIO::ImageSpec& spec,
   }
 }
 
-float Finite(float v) { return std::isfinite(v) ? v : 0.0f; }  // no NaN/Inf leaves a stage
+// No NaN or Inf leaves a stage.
+float Finite(float v) { return std::isfinite(v) ? v : 0.0f; }
 
 // Pixels of `n` channels to `channels` (n itself when 0): alpha is dropped, grey is
 // replicated to RGB, RGB becomes grey by Rec. 601 luma.
