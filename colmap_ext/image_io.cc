@@ -116,8 +116,7 @@ void ConvertChannels(const float* src, int n, size_t pixels, int channels, float
 // read_scanlines does, but without its conversion buffer: that is 64 MiB per call
 // whatever the rows asked for (narrow images read band by band spent 17 s allocating it
 // under ASan: image_fuzzer).
-fvs::Image DecodeInBands(OIIO::ImageInput& input, const std::string& path,
-                         int channels) {
+fvs::Image DecodeInBands(OIIO::ImageInput& input, const std::string& path, int channels) {
   const OIIO::ImageSpec spec = input.spec();
   fvs::Image out;
   out.width = spec.width;
