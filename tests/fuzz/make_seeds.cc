@@ -253,6 +253,8 @@ void ImageSeeds(const std::string& scratch) {
   Seed("image", "tiff_huge_tiles",
        std::string(1, 2) + fvs::testing::TiledTiffBytes(65536));
   Seed("image", "tiff_tiles", std::string(1, 2) + fvs::testing::TiledTiffBytes(64));
+  Seed("image", "tiff_missing_strips",
+       std::string(1, 2) + fvs::testing::StrippedTiffBytes(16396, 13408));
   Seed("image", "pbm_wide", std::string(1, 5) + "P4\n21474837 7 21474836477");
   Seed("image", "pbm_2_to_62_pixels", std::string(1, 5) + "P4\n2147483647 2147483647\n");
   // 185 bytes that OpenImageIO decodes as 8 x 65 293 pixels of 512 channels (zeros where
