@@ -2,6 +2,7 @@
 // OpenImageIO misreading. Shared by the unit tests of ReadImage and the fuzz seeds.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -15,17 +16,16 @@ struct TiffEntry {
 
 // A little-endian TIFF: the header, one directory of `entries` (in tag order), zeros up
 // to byte 200, where the pixel data goes.
-inline std::string TiffBytes(const TiffEntry* entries, int count,
-                             const std::string& data) {
+template <size_t kCount>
+std::string TiffBytes(const TiffEntry (&entries)[kCount], const std::string& data) {
   std::string bytes = "II*";
   auto put = [&bytes](uint64_t value, int size) {
     for (int i = 0; i < size; ++i) bytes += static_cast<char>((value >> (8 * i)) & 0xff);
   };
   put(0, 1);
   put(8, 4);  // the directory follows the header
-  put(count, 2);
-  for (int i = 0; i < count; ++i) {
-    const TiffEntry& e = entries[i];
+  put(kCount, 2);
+  for (const TiffEntry& e : entries) {
     put(e.tag, 2);
     put(e.type, 2);
     put(1, 4);                          // one value
@@ -48,7 +48,7 @@ inline std::string TiledTiffBytes(uint32_t tile_size) {
                                {259, 3, 1},   {262, 3, 1},         {277, 3, 1},
                                {284, 3, 1},   {322, 4, tile_size}, {323, 4, tile_size},
                                {324, 4, 200}, {325, 4, data_bytes}};
-  return TiffBytes(entries, 11, std::string(data_bytes, '\x55'));
+  return TiffBytes(entries, std::string(data_bytes, '\x55'));
 }
 
 // width x height pixels in strips of 3 rows, of which the file gives one offset and 16
@@ -60,7 +60,7 @@ inline std::string StrippedTiffBytes(uint32_t width, uint32_t height) {
   const TiffEntry entries[] = {{256, 4, width}, {257, 4, height}, {258, 3, 8},
                                {259, 3, 1},     {262, 3, 1},      {273, 4, 200},
                                {277, 3, 1},     {278, 3, 3},      {279, 4, 16}};
-  return TiffBytes(entries, 9, std::string(16, '\x55'));
+  return TiffBytes(entries, std::string(16, '\x55'));
 }
 
 }  // namespace fvs::testing
