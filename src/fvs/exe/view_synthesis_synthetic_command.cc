@@ -43,6 +43,8 @@ int RunViewSynthesisSynthetic(int argc, char** argv) {
                      "arc of the camera path between consecutive views");
   options.AddDefault("SyntheticScene.num_sparse_points", &scene.num_sparse_points,
                      "ground-truth 3D points in the sparse model");
+  options.AddDefault("SyntheticScene.plain_walls", &scene.plain_walls,
+                     "walls, floor and ceiling of one plain colour each (textureless)");
   if (!options.Parse(argc, argv)) return 0;
   Require(seed >= 0, "SyntheticScene.seed", "must be >= 0, got " + std::to_string(seed));
   scene.seed = static_cast<uint64_t>(seed);

@@ -27,7 +27,8 @@ nlohmann::json OptionsToJson(const SyntheticSceneOptions& o) {
           {"write_proxy_mesh", o.write_proxy_mesh},
           {"focal_factor", o.focal_factor},
           {"path_step_degrees", o.path_step_degrees},
-          {"num_sparse_points", o.num_sparse_points}};
+          {"num_sparse_points", o.num_sparse_points},
+          {"plain_walls", o.plain_walls}};
 }
 
 void CheckFinite(const Image& image, const std::string& path) {

@@ -58,6 +58,13 @@ class SceneBuilder {
     scene_->materials.push_back(synthetic::RandomMaterial(random_, scale));
     return static_cast<int>(scene_->materials.size()) - 1;
   }
+  // One colour all over (drawn as usual first, so the rest of the scene stays the same):
+  // a textureless wall, floor or ceiling, where NCC says nothing.
+  static void MakePlain(synthetic::ProceduralMaterial* m) {
+    m->palette[1] = m->palette[0];
+    m->pattern_strength = 0;
+    m->grain_strength = 0;
+  }
   int NewPrimitive(const std::string& name) {
     scene_->primitive_names.push_back(name);
     return static_cast<int>(scene_->primitive_names.size()) - 1;
@@ -73,6 +80,7 @@ class SceneBuilder {
       for (int sign = -1; sign <= 1; sign += 2) {
         const int primitive = NewPrimitive(names[2 * axis + (sign > 0)]);
         const int material = NewMaterial(random_->Uniform(1.2, 1.8));
+        if (scene_->options.plain_walls) MakePlain(&scene_->materials[material]);
         Eigen::Vector3d corner = Eigen::Vector3d::Zero(), u = corner, v = corner;
         corner[axis] = sign * half[axis];
         corner[a1] = -half[a1];

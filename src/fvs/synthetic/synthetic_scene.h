@@ -46,6 +46,9 @@ struct SyntheticSceneOptions {
   double path_step_degrees =
       6.0;                       // arc between consecutive views (loop: at most 360 / n)
   int num_sparse_points = 3000;  // ground-truth points3D written with the sparse model
+  // Walls, floor and ceiling of one plain colour each (textureless, as white walls and
+  // black cloth are): the test of stereo where NCC says nothing. Off: the demo scene.
+  bool plain_walls = false;
 
   // Throws fvs::Error("SyntheticScene", ...) for values out of range.
   void Check() const;
