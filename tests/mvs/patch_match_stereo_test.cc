@@ -161,6 +161,17 @@ TEST(PatchMatchStereoTest, SkipsFinishedImagesAndOverwritesOnRequest) {
   EXPECT_EQ(second.num_skipped, 2);
   EXPECT_EQ(fs::last_write_time(ws.DepthMapPath("view_000.png", "geometric")), stamp);
 
+  // Other geometric settings (here the planar prior's): the geometric maps are made again
+  // from the photometric ones, which are kept; the same settings again change nothing.
+  options.planar_prior.max_grey_difference = 0.03;
+  PatchMatchStereoSummary changed = RunPatchMatchStereo(dir.path(), options);
+  EXPECT_EQ(changed.num_photometric_computed, 0);
+  EXPECT_EQ(changed.num_geometric_computed, 2);
+  EXPECT_EQ(RunPatchMatchStereo(dir.path(), options).num_geometric_computed, 0);
+  // A workspace from before the stamp existed: its geometric maps are made again.
+  fs::remove(dir / "stereo/fvs_geometric_options.txt");
+  EXPECT_EQ(RunPatchMatchStereo(dir.path(), options).num_geometric_computed, 2);
+
   // A killed run leaves an image without its geometric map: only that one is redone.
   fs::remove(ws.DepthMapPath("view_001.png", "geometric"));
   PatchMatchStereoSummary third = RunPatchMatchStereo(dir.path(), options);

@@ -148,7 +148,8 @@ void WorkspacePreparation::RunDenseStages(StageRunner* stages) {
               {ws_.ImagesDir(), ws_.SparseDir()}, [&] { Undistort(); });
   stages->Run("stereo", {},
               std::string(builtin_stereo_ ? "builtin" : "colmap") +
-                  " size=" + std::to_string(c_.stereo_max_image_size),
+                  " size=" + std::to_string(c_.stereo_max_image_size) +
+                  (builtin_stereo_ ? " " + c_.planar_prior.ToString() : ""),
               {ws_.StereoDir() + "/depth_maps"}, [&] { Stereo(); });
   stages->Run("fusion", {}, "", {ws_.FusedPath(), ws_.FusedVisPath()}, [&] { Fuse(); });
   stages->Run("meshing", {}, builtin_mesher_ ? "builtin" : "colmap",
@@ -228,6 +229,7 @@ void WorkspacePreparation::Stereo() {
     // view_synthesis_stereo's defaults, at the size asked for.
     mvs::PatchMatchStereoOptions stereo;
     if (c_.stereo_max_image_size > 0) stereo.max_image_size = c_.stereo_max_image_size;
+    stereo.planar_prior = c_.planar_prior;
     RunBuiltinStereo(c_.workspace_path, stereo);
     return;
   }
@@ -281,6 +283,7 @@ void PrepareWorkspaceOptions::Check() const {
           who, "--Mesher.backend must be auto, colmap or builtin");
   Require(max_image_size > 0, who, "--max_image_size must be positive");
   Require(stereo_max_image_size >= 0, who, "--Stereo.max_image_size must be >= 0");
+  planar_prior.Check();
 }
 
 void PrepareWorkspace(const PrepareWorkspaceOptions& options) {

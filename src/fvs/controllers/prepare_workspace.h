@@ -11,6 +11,8 @@
 
 #include <string>
 
+#include "fvs/mvs/planar_prior.h"
+
 namespace fvs {
 
 struct PrepareWorkspaceOptions {
@@ -23,6 +25,8 @@ struct PrepareWorkspaceOptions {
   std::string stereo_backend = "auto";  // auto | colmap | builtin
   std::string mesher_backend = "auto";  // auto (= builtin) | colmap | builtin
   int stereo_max_image_size = 0;        // 0 = full undistorted size
+  // The built-in stereo's fill of textureless and unconfirmed pixels (--PlanarPrior.*).
+  mvs::PlanarPriorOptions planar_prior;
   // Registered by SfM but kept out of stereo, fusion and meshing: a file with one image
   // name per line, or a comma-separated list.
   std::string holdout_images;

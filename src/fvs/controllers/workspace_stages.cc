@@ -19,6 +19,13 @@ void RunBuiltinStereo(const std::string& workspace_path,
             << summary.num_geometric_computed << " geometric maps computed, "
             << summary.num_skipped << " already done, " << summary.num_without_depth_range
             << " without depth range; " << summary.seconds << " s" << std::endl;
+  if (summary.planar_prior.empty > 0) {
+    // How much of what the geometric pass left empty the planar priors filled.
+    std::cerr << "stereo: planar priors filled "
+              << 100.0 * summary.planar_prior.filled / summary.planar_prior.empty
+              << "% of the " << summary.planar_prior.empty << " empty pixels ("
+              << summary.planar_prior.candidates << " had a plane)" << std::endl;
+  }
 }
 
 void RunBuiltinMesher(const std::string& workspace_path, const std::string& output_path,

@@ -5,6 +5,7 @@
 // (controllers/prepare_workspace.h) does the work and states the rules.
 #include "fvs/controllers/prepare_workspace.h"
 #include "fvs/exe/command_registry.h"
+#include "fvs/exe/stereo_flags.h"
 #include "fvs/util/option_manager.h"
 
 namespace fvs {
@@ -34,6 +35,7 @@ int RunPrepare(int argc, char** argv) {
                      "auto (COLMAP when it has CUDA), colmap, builtin");
   options.AddDefault("Stereo.max_image_size", &o.stereo_max_image_size,
                      "longest side for stereo (0 = undistorted size)");
+  AddPlanarPriorFlags(&options, &o.planar_prior);
   options.AddDefault(
       "Mesher.backend", &o.mesher_backend,
       "auto (builtin: COLMAP's algorithm with SfM points), colmap, builtin");

@@ -10,6 +10,7 @@
 
 #include "fvs/controllers/workspace_stages.h"
 #include "fvs/exe/command_registry.h"
+#include "fvs/exe/stereo_flags.h"
 #include "fvs/mvs/patch_match_stereo.h"
 #include "fvs/util/error.h"
 #include "fvs/util/option_manager.h"
@@ -42,6 +43,7 @@ int RunViewSynthesisStereo(int argc, char** argv) {
       p + "min_triangulation_angle", &stereo.min_triangulation_angle,
       "__auto__ sources: minimum triangulation angle of shared points (deg)");
   options.AddDefault(p + "overwrite", &stereo.overwrite, "recompute existing maps");
+  AddPlanarPriorFlags(&options, &stereo.planar_prior);
   options.AddDefault(p + "window_radius", &pm.window_radius,
                      "NCC window radius (pixels)");
   options.AddDefault(p + "window_step", &pm.window_step, "NCC window sampling step");

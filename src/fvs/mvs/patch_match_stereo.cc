@@ -3,15 +3,18 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include "colmap_ext/dense_io.h"
 #include "colmap_ext/image_io.h"
 #include "colmap_ext/sparse_io.h"
 #include "colmap_ext/workspace.h"
 #include "fvs/mvs/stereo_config.h"
+#include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
 #include "fvs/util/parallel.h"
 #include "fvs/util/progress.h"
@@ -24,6 +27,50 @@ namespace fs = std::filesystem;
 bool Exists(const std::string& path) {
   std::error_code ec;
   return fs::is_regular_file(path, ec);
+}
+
+// The world points of the SfM model that `image_id` observes: support of its planar
+// priors.
+std::vector<Eigen::Vector3d> ObservedPoints(const colmap::Reconstruction& rec,
+                                            uint32_t image_id) {
+  std::vector<Eigen::Vector3d> points;
+  const auto it = rec.images.find(image_id);
+  if (it == rec.images.end()) return points;
+  for (const colmap::Point2D& p : it->second.points2D) {
+    if (p.point3D_id == colmap::kInvalidPoint3DId) continue;
+    const auto point = rec.points3D.find(p.point3D_id);
+    if (point != rec.points3D.end() && point->second.xyz.allFinite()) {
+      points.push_back(point->second.xyz);
+    }
+  }
+  return points;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Geometric maps made with other settings go before any is computed, and the stamp is
+// written first: a run killed after this resumes with only the missing maps.
+void InvalidateStaleGeometricMaps(const colmap::DenseWorkspace& ws,
+                                  const std::string& stamp) {
+  const std::string path = ws.StereoDir() + "/fvs_geometric_options.txt";
+  if (ReadText(path) == stamp + "\n") return;
+  for (const std::string dir : {"/depth_maps", "/normal_maps"}) {
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(ws.StereoDir() + dir, ec)) {
+      const std::string name = entry.path().filename().string();
+      const std::string suffix = ".geometric.bin";
+      if (name.size() > suffix.size() &&
+          name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+        fs::remove(entry.path(), ec);
+      }
+    }
+  }
+  WriteFileAtomic(path, [&](std::ostream& out) { out << stamp << "\n"; });
 }
 
 struct ViewSet {
@@ -43,6 +90,20 @@ void PatchMatchStereoOptions::Check() const {
           "max_num_sources must be in [1, 64]");
   Require(min_triangulation_angle >= 0 && min_triangulation_angle < 90, s,
           "min_triangulation_angle must be in [0, 90)");
+  planar_prior.Check();
+}
+
+std::string GeometricOptionsStamp(const PatchMatchStereoOptions& options) {
+  const PatchMatchOptions& p = options.patch_match;
+  std::ostringstream s;
+  s << "geometric iterations=" << p.num_geometric_iterations
+    << " regularizer=" << p.geom_consistency_regularizer
+    << " max_cost=" << p.geom_consistency_max_cost << " filter=" << p.filter
+    << " ncc=" << p.filter_min_ncc << " angle=" << p.filter_min_triangulation_angle
+    << " reprojection=" << p.filter_geom_consistency_max_cost
+    << " consistent=" << p.filter_min_num_consistent
+    << " sources=" << options.max_num_sources << " " << options.planar_prior.ToString();
+  return s.str();
 }
 
 PatchMatchStereoSummary RunPatchMatchStereo(const std::string& workspace_path,
@@ -199,6 +260,7 @@ PatchMatchStereoSummary RunPatchMatchStereo(const std::string& workspace_path,
       }
       return photometric_depths.emplace(id, std::move(depth)).first->second;
     };
+    InvalidateStaleGeometricMaps(ws, GeometricOptionsStamp(options));
     Progress progress("PatchMatch geometric", summary.num_problems);
     for (const StereoProblem& p : problems) {
       const std::string& name = rec.images.at(p.ref_image_id).name;
@@ -219,9 +281,15 @@ PatchMatchStereoSummary RunPatchMatchStereo(const std::string& workspace_path,
                 ws.NormalMapPath(name, "photometric"),
                 "normal map does not match its depth map; rerun with "
                 "--PatchMatchStereo.overwrite 1");
-        const DepthNormalMap map =
+        DepthNormalMap map =
             PatchMatchView(set.views, set.index_of.at(p.ref_image_id), sources_of(p),
                            options.patch_match, &source_depths, &init);
+        const PlanarPriorStats prior = FillFromPlanarPriors(
+            set.views, set.index_of.at(p.ref_image_id), sources_of(p), source_depths,
+            ObservedPoints(rec, p.ref_image_id), options.planar_prior, &map);
+        summary.planar_prior.empty += prior.empty;
+        summary.planar_prior.candidates += prior.candidates;
+        summary.planar_prior.filled += prior.filled;
         colmap::WriteColmapArray(normal_path, map.normal);
         colmap::WriteColmapArray(depth_path, map.depth);
         ++summary.num_geometric_computed;

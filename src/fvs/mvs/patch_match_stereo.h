@@ -10,6 +10,7 @@
 #include <string>
 
 #include "fvs/mvs/patch_match.h"
+#include "fvs/mvs/planar_prior.h"
 #include "fvs/util/image.h"
 
 namespace fvs::mvs {
@@ -26,6 +27,11 @@ struct PatchMatchStereoOptions {
   double min_triangulation_angle = 1.0;
   // Run the geometric-consistency pass and write *.geometric.bin.
   bool geom_consistency = true;
+  // After the geometric pass: fill what it left empty from planar priors
+  // (planar_prior.h). Geometric maps computed with other settings than these (recorded in
+  // W/stereo/fvs_geometric_options.txt; a workspace without that file predates it) are
+  // deleted and computed again; photometric maps are kept.
+  PlanarPriorOptions planar_prior;
   bool overwrite = false;
 
   void Check() const;  // throws fvs::Error("PatchMatchStereo", ...)
@@ -37,8 +43,12 @@ struct PatchMatchStereoSummary {
   int num_geometric_computed = 0;
   int num_skipped = 0;              // reference images whose outputs already existed
   int num_without_depth_range = 0;  // skipped: no sparse point to bound their depth
+  PlanarPriorStats planar_prior;    // summed over the geometric maps computed
   double seconds = 0;
 };
+
+// The settings the geometric maps depend on, as text (the stamp above).
+std::string GeometricOptionsStamp(const PatchMatchStereoOptions& options);
 
 // Throws fvs::Error with one line for a workspace without images or sparse model, fewer
 // than two images, a missing image file, a camera that is not pinhole or an image whose
