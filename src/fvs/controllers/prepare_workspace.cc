@@ -24,6 +24,12 @@ namespace {
 
 const char* kWho = "colmap view_synthesis_prepare";
 
+// COLMAP's default (5) fingerprints as before, so a workspace fused with it is not fused
+// again.
+std::string FusionFingerprint(int min_num_pixels) {
+  return min_num_pixels == 5 ? "" : "min_num_pixels=" + std::to_string(min_num_pixels);
+}
+
 // One run of the stages on resolved options: absolute paths, the holdout names, the
 // photos, and the matcher and backends the installed COLMAP decides.
 class WorkspacePreparation {
@@ -151,7 +157,8 @@ void WorkspacePreparation::RunDenseStages(StageRunner* stages) {
                   " size=" + std::to_string(c_.stereo_max_image_size) +
                   (builtin_stereo_ ? " " + c_.planar_prior.ToString() : ""),
               {ws_.StereoDir() + "/depth_maps"}, [&] { Stereo(); });
-  stages->Run("fusion", {}, "", {ws_.FusedPath(), ws_.FusedVisPath()}, [&] { Fuse(); });
+  stages->Run("fusion", {}, FusionFingerprint(c_.fusion_min_num_pixels),
+              {ws_.FusedPath(), ws_.FusedVisPath()}, [&] { Fuse(); });
   stages->Run("meshing", {}, builtin_mesher_ ? "builtin" : "colmap",
               {ws_.DelaunayMeshPath()}, [&] { Mesh(); });
   stages->Run("depth_cache", {}, "", {ws_.FvsDir() + "/depth"},
@@ -244,7 +251,9 @@ void WorkspacePreparation::Fuse() {
   const std::string out = tmp_dir_ + "/fused.ply";
   colmap::RunColmap({"stereo_fusion", "--workspace_path", c_.workspace_path,
                      "--workspace_format", "COLMAP", "--input_type", "geometric",
-                     "--output_path", out, "--StereoFusion.num_threads", threads_});
+                     "--output_path", out, "--StereoFusion.num_threads", threads_,
+                     "--StereoFusion.min_num_pixels",
+                     std::to_string(c_.fusion_min_num_pixels)});
   std::error_code ec;
   if (!fs::exists(out, ec) || fs::file_size(out, ec) < 300) {
     throw Error(ws_.FusedPath(),
@@ -283,6 +292,7 @@ void PrepareWorkspaceOptions::Check() const {
           who, "--Mesher.backend must be auto, colmap or builtin");
   Require(max_image_size > 0, who, "--max_image_size must be positive");
   Require(stereo_max_image_size >= 0, who, "--Stereo.max_image_size must be >= 0");
+  Require(fusion_min_num_pixels >= 1, who, "--Fusion.min_num_pixels must be >= 1");
   planar_prior.Check();
 }
 

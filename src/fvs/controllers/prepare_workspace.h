@@ -25,6 +25,9 @@ struct PrepareWorkspaceOptions {
   std::string stereo_backend = "auto";  // auto | colmap | builtin
   std::string mesher_backend = "auto";  // auto (= builtin) | colmap | builtin
   int stereo_max_image_size = 0;        // 0 = full undistorted size
+  // COLMAP stereo_fusion's --StereoFusion.min_num_pixels: the views whose depth must
+  // agree on a point before it is fused.
+  int fusion_min_num_pixels = 5;
   // The built-in stereo's fill of textureless and unconfirmed pixels (--PlanarPrior.*).
   mvs::PlanarPriorOptions planar_prior;
   // Registered by SfM but kept out of stereo, fusion and meshing: a file with one image

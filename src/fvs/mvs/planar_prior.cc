@@ -97,7 +97,9 @@ class PriorFiller {
   }
 
   // Tries every level, finest first; true with the depth and normal the sources accept.
-  bool Fill(int x, int y, double* depth, Eigen::Vector3d* normal,
+  // `photometric`: the pixel's photometric depth (0: none); one that agrees with the
+  // plane needs only one confirming source, and is kept.
+  bool Fill(int x, int y, float photometric, double* depth, Eigen::Vector3d* normal,
             bool* had_candidate) const {
     const Eigen::Vector3d ray = ref_.camera.PixelToCamera(x + 0.5, y + 0.5, 1.0);
     for (const Level& level : levels_) {
@@ -108,8 +110,11 @@ class PriorFiller {
       const double d = plane.normal.dot(plane.point) / denom;
       if (!(d >= ref_.depth_min && d <= ref_.depth_max) || !std::isfinite(d)) continue;
       *had_candidate = true;
-      if (SourcesAgree(x, y, d, plane)) {
-        *depth = d;
+      const bool measured = photometric > 0 && std::isfinite(photometric) &&
+                            std::abs(photometric - d) <= o_.depth_tolerance * d;
+      const double candidate = measured ? photometric : d;
+      if (SourcesAgree(x, y, candidate, plane, measured ? 1 : o_.min_num_consistent)) {
+        *depth = candidate;
         *normal = plane.normal;
         return true;
       }
@@ -195,7 +200,7 @@ class PriorFiller {
 
   // No source saw free space behind the point, and min_num_consistent sources confirm
   // it: by their own depth where they have one, else by the grey of the window.
-  bool SourcesAgree(int x, int y, double depth, const Plane& plane) const {
+  bool SourcesAgree(int x, int y, double depth, const Plane& plane, int required) const {
     const PinholeCamera& rc = ref_.camera;
     const Eigen::Vector3d world =
         rc.CameraToWorld(rc.PixelToCamera(x + 0.5, y + 0.5, depth));
@@ -219,7 +224,7 @@ class PriorFiller {
       }
       if (GreyAgrees(x, y, plane, src)) ++consistent;
     }
-    return consistent >= o_.min_num_consistent;
+    return consistent >= required;
   }
 
   bool GreyAgrees(int x, int y, const Plane& plane, const StereoView& src) const {
@@ -306,6 +311,7 @@ PlanarPriorStats FillFromPlanarPriors(const std::vector<StereoView>& views, int 
                                       const std::vector<int>& sources,
                                       const std::vector<const Image*>& source_depths,
                                       const std::vector<Eigen::Vector3d>& sparse_points,
+                                      const Image* photometric,
                                       const PlanarPriorOptions& options,
                                       DepthNormalMap* map) {
   options.Check();
@@ -320,6 +326,9 @@ PlanarPriorStats FillFromPlanarPriors(const std::vector<StereoView>& views, int 
                 source_depths[s]->height == c.height && source_depths[s]->channels == 1,
             views[sources[s]].name, "depth map does not match the camera size");
   }
+  Require(!photometric || (photometric->width == rv.camera.width &&
+                           photometric->height == rv.camera.height),
+          rv.name, "photometric depth map does not match the camera size");
   Require(map->depth.width == rv.camera.width && map->depth.height == rv.camera.height &&
               map->normal.width == rv.camera.width && map->normal.channels == 3,
           rv.name, "depth/normal map does not match the camera size");
@@ -337,8 +346,9 @@ PlanarPriorStats FillFromPlanarPriors(const std::vector<StereoView>& views, int 
       double depth = 0;
       Eigen::Vector3d normal;
       bool had_candidate = false;
-      if (filler.Fill(x, y, &depth, &normal, &had_candidate) && std::isfinite(depth) &&
-          normal.allFinite()) {
+      const float measured = photometric ? photometric->at(x, y) : 0.f;
+      if (filler.Fill(x, y, measured, &depth, &normal, &had_candidate) &&
+          std::isfinite(depth) && normal.allFinite()) {
         map->depth.at(x, y) = static_cast<float>(depth);
         for (int c = 0; c < 3; ++c)
           map->normal.at(x, y, c) = static_cast<float>(normal[c]);

@@ -57,11 +57,15 @@ struct PlanarPriorStats {
 // Fills the pixels of `map` (views[ref]'s result of the geometric pass) that have no
 // depth. `source_depths`: one depth map per source (the sources' photometric maps, at
 // their working resolution; empty pixels are 0). `sparse_points`: world points the
-// reference view observes (its SfM points). Never writes a non-finite depth or normal.
+// reference view observes (its SfM points). `photometric` (may be null): the reference's
+// photometric map; a photometric depth that the geometric filter removed but that agrees
+// with the plane is kept when one source confirms it (no second view needed). Never
+// writes a non-finite depth or normal.
 PlanarPriorStats FillFromPlanarPriors(const std::vector<StereoView>& views, int ref,
                                       const std::vector<int>& sources,
                                       const std::vector<const Image*>& source_depths,
                                       const std::vector<Eigen::Vector3d>& sparse_points,
+                                      const Image* photometric,
                                       const PlanarPriorOptions& options,
                                       DepthNormalMap* map);
 
