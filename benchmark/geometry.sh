@@ -152,10 +152,12 @@ for spec in "${SCENES[@]}"; do
   fi
   if [[ ${FVS_GEOMETRY_HEADROOM:-0} == 1 && -s $ws/fvs/holdout.txt && ! -f $OUT/$name.headroom/done ]]; then
     mkdir -p "$OUT/$name.headroom"
-    FVS_QUIET=1 "$COLMAP" view_synthesis_pack --workspace_path "$ws" \
+    # Half size, as the training set and doc/training.md's headroom tables.
+    FVS_QUIET=1 "$COLMAP" view_synthesis_pack --workspace_path "$ws" --scale 0.5 \
       --output_path "$OUT/$name.headroom/packed" > "$OUT/$name.headroom/log" 2>&1 &&
     echo "$OUT/$name.headroom/packed" > "$OUT/$name.headroom/list.txt" &&
     FVS_QUIET=1 "$COLMAP" view_synthesis_train --Train.headroom 1 \
+      --scene_list "$OUT/$name.headroom/list.txt" "${LPIPS_ARGS[@]}" \
       --val_scene_list "$OUT/$name.headroom/list.txt" --Train.holdout_targets 1 \
       --Train.headroom_methods ulr,oracle_pixel,oracle_patch8 \
       --output_path "$OUT/$name.headroom" >> "$OUT/$name.headroom/log" 2>&1 &&
@@ -202,7 +204,9 @@ for spec in sys.argv[2:]:
             row += " | %s %.1f%%<1%% %.1f%%<5%% med %.4f" % (key, 100 * e["within_1pct"],
                    100 * e["within_5pct"], e["median_rel_error"])
     print(row)
-    hr = os.path.join(out, name + ".headroom")
-    for f in sorted(os.listdir(hr)) if os.path.isdir(hr) else []:
-        if f.endswith(".csv"): print("    headroom %s: %s" % (f, open(os.path.join(hr, f)).read().strip().replace("\n", " | ")))
+    csv_path = os.path.join(out, name + ".headroom", "headroom.csv")
+    if os.path.exists(csv_path):  # half size, the held-out views, K = 5
+        print("    headroom (half size): " + " | ".join("%s %.2f / %.4f / %.4f" % (
+            r["method"], float(r["psnr"]), float(r["ssim"]), float(r["lpips"]))
+            for r in csv.DictReader(open(csv_path)) if r["scene"] == "all"))
 EOF

@@ -184,9 +184,13 @@ TEST(PatchMatchStereoTest, SkipsFinishedImagesAndOverwritesOnRequest) {
   EXPECT_EQ(fourth.num_photometric_computed, 2);
   EXPECT_EQ(fourth.num_geometric_computed, 2);
 
-  // Downscaled: maps at the working size.
+  // Downscaled: maps at the working size, made again without asking (overwrite off), as
+  // view_synthesis_prepare --Stereo.max_image_size does on an existing workspace.
+  options.overwrite = false;
   options.max_image_size = 32;
-  RunPatchMatchStereo(dir.path(), options);
+  PatchMatchStereoSummary resized = RunPatchMatchStereo(dir.path(), options);
+  EXPECT_EQ(resized.num_photometric_computed, 2);
+  EXPECT_EQ(resized.num_geometric_computed, 2);
   const Image small =
       colmap::ReadColmapArray(ws.DepthMapPath("view_000.png", "geometric"));
   EXPECT_EQ(small.width, 32);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -44,6 +45,16 @@ std::vector<Eigen::Vector3d> ObservedPoints(const colmap::Reconstruction& rec,
     }
   }
   return points;
+}
+
+// Whether the COLMAP array at `path` ("W&H&C&" header) is width x height: a map made at
+// another --max_image_size is computed again rather than failing the geometric pass.
+bool ArrayHasSize(const std::string& path, int width, int height) {
+  std::ifstream in(path, std::ios::binary);
+  char header[64] = {0};
+  in.read(header, sizeof(header) - 1);
+  int w = 0, h = 0, c = 0;
+  return std::sscanf(header, "%d&%d&%d&", &w, &h, &c) == 3 && w == width && h == height;
 }
 
 std::string ReadText(const std::string& path) {
@@ -225,8 +236,10 @@ PatchMatchStereoSummary RunPatchMatchStereo(const std::string& workspace_path,
       const std::string& name = rec.images.at(p.ref_image_id).name;
       const std::string depth_path = ws.DepthMapPath(name, "photometric");
       const std::string normal_path = ws.NormalMapPath(name, "photometric");
-      if (solvable(p) &&
-          (options.overwrite || !Exists(depth_path) || !Exists(normal_path))) {
+      const PinholeCamera& working = set.views[set.index_of.at(p.ref_image_id)].camera;
+      const bool current = Exists(depth_path) && Exists(normal_path) &&
+                           ArrayHasSize(depth_path, working.width, working.height);
+      if (solvable(p) && (options.overwrite || !current)) {
         const DepthNormalMap map =
             PatchMatchView(set.views, set.index_of.at(p.ref_image_id), sources_of(p),
                            photometric_options);
