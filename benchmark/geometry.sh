@@ -2,7 +2,8 @@
 # The geometry benchmark (issue 39, doc/real_scenes.md): prepares scenes of
 # ../shared/datasets with every 5th photo held out of the geometry, and a generated scene
 # with exact depth, then reports per scene the coverage of the stereo maps and of the mesh
-# (geometry_benchmark), the depth error where the truth is known, `ulr` PSNR / SSIM / LPIPS
+# (geometry_benchmark), the depth error where the truth is known (Middlebury: camera error
+# against the published calibration), `ulr` PSNR / SSIM / LPIPS
 # on the held-out views with seconds per view, and seconds per stage (W/fvs/manifest.json).
 #
 #   benchmark/geometry.sh [SCENE[:STEP] ...]   # default: synthetic and every dataset scene
@@ -140,6 +141,9 @@ for spec in "${SCENES[@]}"; do
   else
     prepare_dataset "$scene" "$step" "$ws" || continue
     truth=()
+    # The Middlebury scenes ship their published calibration as sparse/0.
+    [[ $scene == middlebury_* && -d $DATASETS/$scene/sparse/0 ]] &&
+      truth=(--reference_model "$DATASETS/$scene/sparse/0")
   fi
   base=()
   [[ -n $BASELINE && -f $WORK/$BASELINE/$name/.done ]] && base=(--baseline_path "$WORK/$BASELINE/$name")

@@ -6,12 +6,17 @@
 // view_synthesis_synthetic writes it, in the workspace's frame): the share of the
 // geometric map's and the mesh's pixels within 1 % and 5 % of the true depth and their
 // median relative error. With --baseline_path (the same photos prepared before a change)
-// the same shares for the pixels newly covered: with depth here, none there.
+// the same shares for the pixels newly covered: with depth here, none there. With
+// --reference_model (a COLMAP model of the same photos with known cameras, e.g. the
+// published Middlebury calibration in ../shared/datasets/<scene>/sparse/0): the cameras
+// of W/sparse after the best similarity onto it, as centre error relative to the
+// reference cameras' extent and rotation error in degrees.
 //
 //   geometry_benchmark --workspace_path W [--truth_path T] [--baseline_path W0]
-//                      [--output_path report.json]
+//                      [--reference_model M] [--output_path report.json]
 //
 // Prints one summary line per measure and writes every view's numbers as JSON.
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -25,6 +30,8 @@
 
 #include "benchmark/benchmark_args.h"
 #include "colmap_ext/dense_io.h"
+#include "colmap_ext/reconstruction.h"
+#include "colmap_ext/sparse_io.h"
 #include "colmap_ext/workspace.h"
 #include "fvs/scene/mesh_coverage.h"
 #include "fvs/scene/scene.h"
@@ -38,7 +45,7 @@ namespace fs = std::filesystem;
 
 const char* kUsage =
     "usage: geometry_benchmark --workspace_path W [--truth_path T] [--baseline_path W0]\n"
-    "                          [--output_path report.json]";
+    "                          [--reference_model M] [--output_path report.json]";
 
 // Nearest pixel of `map` for pixel (x, y) of an image of size (width, height): stereo
 // maps may be smaller than the photo (--Stereo.max_image_size).
@@ -123,10 +130,57 @@ struct Accumulator {
   }
 };
 
+// The workspace's cameras against a reference model of the same photos (matched by
+// name), after the similarity that maps the estimated centres onto the reference ones.
+nlohmann::json CompareCameras(const std::string& sparse_dir,
+                              const std::string& reference_dir) {
+  const colmap::Reconstruction est = colmap::ReadSparseModel(sparse_dir);
+  const colmap::Reconstruction ref = colmap::ReadSparseModel(reference_dir);
+  std::map<std::string, const colmap::Image*> by_name;
+  for (const auto& [id, image] : ref.images) by_name[image.name] = &image;
+  std::vector<const colmap::Image*> e, r;
+  for (const auto& [id, image] : est.images) {
+    const auto it = by_name.find(image.name);
+    if (it != by_name.end()) e.push_back(&image), r.push_back(it->second);
+  }
+  nlohmann::json j;
+  j["matched"] = e.size();
+  j["reference_images"] = ref.images.size();
+  if (e.size() < 3) return j;
+  Eigen::Matrix3Xd src(3, e.size()), dst(3, e.size());
+  for (size_t i = 0; i < e.size(); ++i) {
+    src.col(i) = e[i]->ProjectionCenter();
+    dst.col(i) = r[i]->ProjectionCenter();
+  }
+  const Eigen::Matrix4d sim = Eigen::umeyama(src, dst, true);
+  const double scale = sim.block<3, 1>(0, 0).norm();
+  const Eigen::Matrix3d rotation = sim.block<3, 3>(0, 0) / scale;
+  const double extent = (dst.rowwise().maxCoeff() - dst.rowwise().minCoeff()).norm();
+  std::vector<double> centre, angle;
+  for (size_t i = 0; i < e.size(); ++i) {
+    const Eigen::Vector3d c = (sim * src.col(i).homogeneous()).head<3>();
+    centre.push_back((c - dst.col(i)).norm() / extent);
+    // World-to-camera rotations: est R_e maps the aligned world by R_e * rotation^T.
+    const Eigen::Matrix3d diff =
+        r[i]->Rotation() * (e[i]->Rotation() * rotation.transpose()).transpose();
+    angle.push_back(Eigen::AngleAxisd(diff).angle() * 180.0 / 3.14159265358979323846);
+  }
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  j["centre_error_median"] = median(centre);
+  j["centre_error_max"] = *std::max_element(centre.begin(), centre.end());
+  j["rotation_error_median_deg"] = median(angle);
+  j["rotation_error_max_deg"] = *std::max_element(angle.begin(), angle.end());
+  return j;
+}
+
 int Run(int argc, char** argv) {
   benchmark::CheckArgs(
       argc, argv, kUsage,
-      {"--workspace_path", "--truth_path", "--baseline_path", "--output_path"});
+      {"--workspace_path", "--truth_path", "--baseline_path", "--output_path",
+       "--reference_model"});
   std::map<std::string, std::string> args;
   for (int i = 1; i + 1 < argc; i += 2) args[argv[i]] = argv[i + 1];
   if (!args.count("--workspace_path")) {
@@ -227,6 +281,23 @@ int Run(int argc, char** argv) {
           "%-22s %zu px: %5.1f %% within 1 %%, %5.1f %% within 5 %%, median %.4f\n", key,
           e["pixels"].get<size_t>(), 100 * e["within_1pct"].get<double>(),
           100 * e["within_5pct"].get<double>(), e["median_rel_error"].get<double>());
+    }
+  }
+  if (args.count("--reference_model")) {
+    const nlohmann::json c = CompareCameras(ws.SparseDir(), args["--reference_model"]);
+    report["cameras"] = c;
+    if (c.contains("centre_error_median")) {
+      std::printf(
+          "%-22s %d of %d matched: centre error median %.4f, max %.4f of the "
+          "cameras' extent; rotation median %.3f, max %.3f deg\n",
+          "cameras vs reference", c["matched"].get<int>(),
+          c["reference_images"].get<int>(), c["centre_error_median"].get<double>(),
+          c["centre_error_max"].get<double>(),
+          c["rotation_error_median_deg"].get<double>(),
+          c["rotation_error_max_deg"].get<double>());
+    } else {
+      std::printf("cameras vs reference    only %d images matched by name\n",
+                  c["matched"].get<int>());
     }
   }
   report["views"] = views;
