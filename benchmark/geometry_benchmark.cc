@@ -200,14 +200,19 @@ int Run(int argc, char** argv) {
   if (!baseline_root.empty()) {
     baseline_scene = std::make_unique<Scene>(Scene::Load(baseline_root));
   }
-  Accumulator photometric, geometric, mesh, mesh_held_out;
+  Accumulator photometric, geometric, mesh, mesh_held_out, with_backdrop;
+  const bool has_backdrop = !scene.backdrop().faces.empty();
   ErrorSample stereo_errors, mesh_errors;
   nlohmann::json views = nlohmann::json::object();
   for (int i = 0; i < scene.num_views(); ++i) {
     const std::string& name = scene.view(i).name;
     nlohmann::json v;
-    const double mesh_fraction = SurfaceFraction(scene.SourceDepth(i));
+    // The source depths hold the backdrop too (scene/backdrop.h): the mesh alone here.
+    const Image mesh_depth =
+        has_backdrop ? scene.RenderMeshDepth(scene.view(i).camera) : scene.SourceDepth(i);
+    const double mesh_fraction = SurfaceFraction(mesh_depth);
     v["mesh"] = mesh_fraction;
+    v["mesh_and_backdrop"] = SurfaceFraction(scene.SourceDepth(i));
     v["held_out"] = holdout.count(name) > 0;
     if (holdout.count(name)) {
       mesh_held_out.Add(mesh_fraction, name);
@@ -215,6 +220,7 @@ int Run(int argc, char** argv) {
       continue;
     }
     mesh.Add(mesh_fraction, name);
+    with_backdrop.Add(v["mesh_and_backdrop"].get<double>(), name);
     const Image photo = ReadIfExists(ws.DepthMapPath(name, "photometric"));
     const Image geo = ReadIfExists(ws.DepthMapPath(name, "geometric"));
     if (photo.width > 0) photometric.Add(SurfaceFraction(photo), name);
@@ -229,13 +235,13 @@ int Run(int argc, char** argv) {
       if (baseline_scene) {
         base_geo = ReadIfExists(base.DepthMapPath(name, "geometric"));
         const int j = baseline_scene->FindView(name);
-        if (j >= 0) base_mesh = baseline_scene->SourceDepth(j);
+        if (j >= 0) base_mesh = baseline_scene->RenderMeshDepth(baseline_scene->view(j).camera);
       }
       ErrorSample view_stereo, view_mesh;
       if (geo.width > 0) {
         CollectErrors(geo, truth, baseline_scene ? &base_geo : nullptr, &view_stereo);
       }
-      CollectErrors(scene.SourceDepth(i), truth, baseline_scene ? &base_mesh : nullptr,
+      CollectErrors(mesh_depth, truth, baseline_scene ? &base_mesh : nullptr,
                     &view_mesh);
       v["geometric_error"] = Summarize(view_stereo.all);
       v["mesh_error"] = Summarize(view_mesh.all);
@@ -253,6 +259,7 @@ int Run(int argc, char** argv) {
   report["geometric"] = geometric.Json();
   report["mesh"] = mesh.Json();
   report["mesh_held_out"] = mesh_held_out.Json();
+  report["mesh_and_backdrop"] = with_backdrop.Json();
   auto line = [](const char* what, const Accumulator& a) {
     if (a.count == 0) return;
     std::printf("%-22s mean %5.1f %%  least %5.1f %% (%s), %d views\n", what,
@@ -262,6 +269,7 @@ int Run(int argc, char** argv) {
   line("geometric maps", geometric);
   line("mesh", mesh);
   line("mesh, held-out views", mesh_held_out);
+  if (has_backdrop) line("mesh and backdrop", with_backdrop);
   if (!truth_root.empty()) {
     report["geometric_error"] = Summarize(stereo_errors.all);
     report["mesh_error"] = Summarize(mesh_errors.all);

@@ -1,7 +1,14 @@
 #include "fvs/controllers/workspace_stages.h"
 
+#include <filesystem>
 #include <iostream>
 
+#include "colmap_ext/image_io.h"
+#include "colmap_ext/sparse_io.h"
+#include "colmap_ext/workspace.h"
+#include "fvs/controllers/prepare_stages.h"
+#include "fvs/controllers/stage_runner.h"
+#include "fvs/geometry/ply.h"
 #include "fvs/scene/mesh_coverage.h"
 #include "fvs/scene/scene.h"
 #include "fvs/util/atomic_file.h"
@@ -44,6 +51,48 @@ void RunBuiltinMesher(const std::string& workspace_path, const std::string& outp
   std::cout << "Delaunay mesher: " << stats.Summary() << "\n"
             << "Wrote " << output_path << std::endl;
 #endif
+}
+
+void BuildBackdrop(const std::string& workspace_path, const BackdropOptions& options) {
+  options.Check();
+  Timer timer;
+  const colmap::DenseWorkspace ws(workspace_path);
+  const std::string ply = ws.FvsDir() + "/backdrop.ply";
+  BackdropFit fit;
+  if (options.enabled) {
+    const std::string holdout_file = ws.FvsDir() + "/holdout.txt";
+    const std::set<std::string> holdout = std::filesystem::exists(holdout_file)
+                                              ? ParseHoldoutList(holdout_file)
+                                              : std::set<std::string>();
+    const colmap::Reconstruction rec = colmap::ReadSparseModel(ws.SparseDir());
+    std::vector<BackdropView> views;
+    for (const auto& [image_id, image] : rec.images) {
+      if (holdout.count(image.name)) continue;  // never seen by the geometry
+      BackdropView v;
+      v.camera = rec.PinholeFor(image_id);
+      v.photo = colmap::ReadImage(ws.ImagePath(image.name), 3);
+      views.push_back(std::move(v));
+    }
+    const TriangleMesh mesh = ReadPlyMesh(ws.DelaunayMeshPath());
+    fit = FitBackdrop(views, mesh, options);
+  }
+  if (fit.mesh.faces.empty()) {
+    RemoveAll(ply);
+  } else {
+    PlyWriteOptions write;
+    write.double_precision = true;  // a scene far from the origin
+    WritePlyMesh(ply, fit.mesh, write);
+  }
+  std::cerr << (options.enabled ? fit.Summary() : "backdrop: off") << "; "
+            << timer.Seconds() << " s\n";
+  WriteFileAtomic(ws.FvsDir() + "/backdrop.json", [&](std::ostream& out) {
+    out << "{\"enabled\": " << (options.enabled ? "true" : "false")
+        << ", \"directions\": " << fit.num_directions << ", \"finite\": " << fit.num_finite
+        << ", \"infinity\": " << fit.num_infinity
+        << ", \"unexplained\": " << fit.num_unexplained
+        << ", \"unseen\": " << fit.num_unseen << ", \"faces\": " << fit.mesh.faces.size()
+        << ", \"options\": \"" << options.ToString() << "\"}\n";
+  });
 }
 
 void BuildDepthCache(const std::string& workspace_path, int num_threads) {

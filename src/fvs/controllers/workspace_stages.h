@@ -8,6 +8,7 @@
 
 #include "fvs/mvs/delaunay.h"
 #include "fvs/mvs/patch_match_stereo.h"
+#include "fvs/scene/backdrop.h"
 
 namespace fvs {
 
@@ -21,6 +22,12 @@ void RunBuiltinStereo(const std::string& workspace_path,
 // CGAL or Boost.Graph, or for bad input (nothing written then).
 void RunBuiltinMesher(const std::string& workspace_path, const std::string& output_path,
                       const mvs::DelaunayMeshingOptions& options);
+
+// Fits the backdrop (scene/backdrop.h) to the photos of W that are not held out
+// (W/fvs/holdout.txt) around W/meshed-delaunay.ply: W/fvs/backdrop.ply (world frame; no
+// file when nothing was kept) and its summary W/fvs/backdrop.json. Throws fvs::Error for
+// an unusable workspace.
+void BuildBackdrop(const std::string& workspace_path, const BackdropOptions& options);
 
 // Renders the depth of every source view from the mesh into W/fvs/depth/ (reusing what
 // is current: scene/depth_cache.h) and writes how much of the photos the mesh covers to

@@ -1,7 +1,7 @@
 // colmap view_synthesis_prepare --image_path P --workspace_path W
 //
-// Photos -> ready scene: SfM, undistortion, dense stereo, fusion, meshing, source depth
-// cache, each stage skipped when it is current and a killed run resumed: PrepareWorkspace
+// Photos -> ready scene: SfM, undistortion, dense stereo, fusion, meshing, backdrop,
+// source depth cache, each stage skipped when it is current and a killed run resumed: PrepareWorkspace
 // (controllers/prepare_workspace.h) does the work and states the rules.
 #include "fvs/controllers/prepare_workspace.h"
 #include "fvs/exe/command_registry.h"
@@ -16,7 +16,7 @@ int RunPrepare(int argc, char** argv) {
   OptionManager options(
       "view_synthesis_prepare",
       "Photos to a ready view-synthesis scene: SfM, undistortion, dense "
-      "stereo, fusion, meshing, source depth cache. Finished stages are "
+      "stereo, fusion, meshing, backdrop, source depth cache. Finished stages are "
       "skipped; a killed run resumes.");
   options.AddRequired("image_path", &o.image_path, "folder of the input photos");
   options.AddRequired("workspace_path", &o.workspace_path, "output dense workspace");
@@ -39,6 +39,20 @@ int RunPrepare(int argc, char** argv) {
   options.AddDefault("Fusion.min_num_pixels", &o.fusion_min_num_pixels,
                      "views whose depths must agree on a fused point (COLMAP's "
                      "StereoFusion.min_num_pixels)");
+  options.AddDefault("Backdrop.enabled", &o.backdrop.enabled,
+                     "fit what lies beyond the mesh (a black cloth, a table top) to the "
+                     "photos before falling back to infinity");
+  options.AddDefault("Backdrop.subdivisions", &o.backdrop.subdivisions,
+                     "directions of the backdrop: 10 * 4^s + 2");
+  options.AddDefault("Backdrop.max_image_size", &o.backdrop.max_image_size,
+                     "longest side of the photos the backdrop fit compares");
+  options.AddDefault("Backdrop.min_views", &o.backdrop.min_views,
+                     "photos that must see a backdrop point");
+  options.AddDefault("Backdrop.infinity_margin", &o.backdrop.infinity_margin,
+                     "colour std by which infinity must agree better to be kept");
+  options.AddDefault("Backdrop.max_colour_std", &o.backdrop.max_colour_std,
+                     "directions whose colours disagree more at every radius are "
+                     "left to infinity");
   options.AddDefault(
       "Mesher.backend", &o.mesher_backend,
       "auto (builtin: COLMAP's algorithm with SfM points), colmap, builtin");
@@ -55,7 +69,7 @@ int RunPrepare(int argc, char** argv) {
 }  // namespace
 
 FVS_REGISTER_COMMAND("view_synthesis_prepare",
-                     "photos -> ready scene (SfM, stereo, fusion, mesh, depth cache)",
+                     "photos -> ready scene (SfM, stereo, fusion, mesh, backdrop, depth cache)",
                      RunPrepare);
 
 }  // namespace fvs

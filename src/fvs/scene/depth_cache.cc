@@ -29,16 +29,22 @@ nlohmann::json MeshStamp(const std::string& mesh_path) {
 }  // namespace
 
 SourceDepthCache::SourceDepthCache(const std::string& workspace_path,
-                                   const std::string& mesh_path, bool enabled)
+                                   const std::string& mesh_path,
+                                   const std::string& backdrop_path, bool enabled)
     : root_(colmap::DenseWorkspace(workspace_path).FvsDir() + "/depth"),
       stamp_path_(root_ + "/stamp.json"),
       enabled_(enabled),
       mesh_stamp_(MeshStamp(mesh_path)) {
+  if (fs::exists(backdrop_path)) backdrop_stamp_ = MeshStamp(backdrop_path);
   if (!enabled_ || !fs::exists(stamp_path_)) return;
   try {
     const nlohmann::json stamp = nlohmann::json::parse(ReadFileToString(stamp_path_));
-    // A changed mesh invalidates every depth; a bad stamp file is treated as no cache.
-    if (stamp.at("mesh") == mesh_stamp_ && stamp.at("views").is_object()) {
+    // A changed mesh or backdrop invalidates every depth (a stamp written before the
+    // backdrop existed has none); a bad stamp file is treated as no cache.
+    const nlohmann::json backdrop =
+        stamp.contains("backdrop") ? stamp.at("backdrop") : nlohmann::json();
+    if (stamp.at("mesh") == mesh_stamp_ && backdrop == backdrop_stamp_ &&
+        stamp.at("views").is_object()) {
       views_ = stamp.at("views");
     }
   } catch (const std::exception&) {
@@ -98,6 +104,7 @@ void SourceDepthCache::Commit() {
   if (!enabled_ || !dirty_) return;
   nlohmann::json stamp;
   stamp["mesh"] = mesh_stamp_;
+  if (!backdrop_stamp_.is_null()) stamp["backdrop"] = backdrop_stamp_;
   stamp["views"] = views_;
   WriteFileAtomic(stamp_path_, [&](std::ostream& out) { out << stamp.dump(1) << "\n"; });
   dirty_ = false;

@@ -23,7 +23,10 @@ MeshCoverage MeasureMeshCoverage(const Scene& scene) {
   MeshCoverage coverage;
   double sum = 0;
   for (int i = 0; i < scene.num_views(); ++i) {
-    const double f = SurfaceFraction(scene.SourceDepth(i));
+    // The source depths hold the backdrop too: measure the mesh alone then.
+    const double f = SurfaceFraction(scene.backdrop().faces.empty()
+                                         ? scene.SourceDepth(i)
+                                         : scene.RenderMeshDepth(scene.view(i).camera));
     coverage.names.push_back(scene.view(i).name);
     coverage.fractions.push_back(f);
     sum += f;

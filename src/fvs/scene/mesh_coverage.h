@@ -1,6 +1,6 @@
 // How much of what the photos show the proxy mesh covers: for each registered view, the
 // fraction of its pixels where the mesh rendered into that view has a surface (the source
-// depth cache; 0 = no surface). Pixels without a surface are rendered from the background
+// depth cache; 0 = no surface; the mesh alone when the scene has a backdrop). Pixels without a surface are rendered from the background
 // at infinity, or filled, so a low fraction where the photo shows near things means the
 // geometry lost them (doc/real_scenes.md).
 #pragma once

@@ -7,6 +7,7 @@
 #include "colmap_ext/workspace.h"
 #include "fvs/geometry/ply.h"
 #include "fvs/geometry/rasterizer.h"
+#include "fvs/scene/backdrop.h"
 #include "fvs/scene/depth_cache.h"
 #include "fvs/util/error.h"
 #include "fvs/util/progress.h"
@@ -62,6 +63,10 @@ int Scene::FindView(const std::string& name) const {
 }
 
 Image Scene::RenderDepth(const PinholeCamera& scene_camera) const {
+  return RenderWithBackdrop(mesh_, backdrop_, scene_camera, num_threads_);
+}
+
+Image Scene::RenderMeshDepth(const PinholeCamera& scene_camera) const {
   RasterizeOptions options;
   options.num_threads = num_threads_;
   return Rasterize(mesh_, scene_camera, options).depth;
@@ -141,8 +146,17 @@ Scene Scene::Load(const std::string& workspace_path, const SceneLoadOptions& opt
   const TriangleMesh mesh = ReadPlyMesh(mesh_path);
   CheckMesh(mesh, mesh_path);
   scene.Centre(views, mesh);
+  const std::string backdrop_path = workspace.FvsDir() + "/backdrop.ply";
+  if (std::filesystem::is_regular_file(backdrop_path)) {
+    scene.backdrop_ = ReadPlyMesh(backdrop_path);
+    for (const auto& v : scene.backdrop_.vertices) {
+      Require(v.allFinite(), backdrop_path, "the backdrop has a non-finite vertex");
+    }
+    for (Eigen::Vector3d& x : scene.backdrop_.vertices) x -= scene.origin_;
+  }
 
-  SourceDepthCache cache(workspace_path, mesh_path, options.use_depth_cache);
+  SourceDepthCache cache(workspace_path, mesh_path, backdrop_path,
+                         options.use_depth_cache);
   Progress progress("source depths", scene.num_views());
   for (const SceneView& v : scene.views_) {
     // The cache keys on the world camera: the scene origin may move when views change.

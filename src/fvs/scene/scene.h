@@ -37,7 +37,8 @@ struct SceneLoadOptions {
 
 class Scene {
  public:
-  // Loads W/sparse (via ReadSparseModel), W/meshed-delaunay.ply, and the source depth
+  // Loads W/sparse (via ReadSparseModel), W/meshed-delaunay.ply, the backdrop
+  // W/fvs/backdrop.ply when prepare fitted one (scene/backdrop.h), and the source depth
   // cache (computing what is missing or stale). Throws fvs::Error naming what is missing
   // or bad.
   static Scene Load(const std::string& workspace_path,
@@ -58,6 +59,8 @@ class Scene {
   int FindView(const std::string& name) const;
 
   const TriangleMesh& mesh() const { return mesh_; }  // scene-centred
+  // What lies beyond the mesh (scene/backdrop.h), scene-centred; no faces when none.
+  const TriangleMesh& backdrop() const { return backdrop_; }
   const Eigen::Vector3d& origin() const { return origin_; }
   const std::string& workspace_path() const { return workspace_path_; }
 
@@ -73,8 +76,12 @@ class Scene {
   // For in-memory scenes: sets the photo of view i (size must match the camera).
   void SetSourceImage(int i, Image image);
 
-  // Depth of the mesh seen by a scene-centred camera (1 channel, 0 = no surface).
+  // Depth seen by a scene-centred camera (1 channel, 0 = no surface): the mesh, and the
+  // backdrop where the mesh has no surface (RenderWithBackdrop). Every source depth and
+  // every target depth is this.
   Image RenderDepth(const PinholeCamera& scene_camera) const;
+  // The mesh alone (what the mesh's coverage measures).
+  Image RenderMeshDepth(const PinholeCamera& scene_camera) const;
 
   // Seconds spent loading (sparse model, mesh, depth cache); for reports.
   double load_seconds() const { return load_seconds_; }
@@ -87,6 +94,7 @@ class Scene {
   std::string workspace_path_;  // empty for in-memory scenes
   std::vector<SceneView> views_;
   TriangleMesh mesh_;
+  TriangleMesh backdrop_;
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
   std::vector<std::shared_ptr<const Image>> source_depths_;
   // Lazily loaded photos; the mutex is held only to publish a loaded image.

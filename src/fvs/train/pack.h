@@ -16,6 +16,7 @@
 #include <string>
 
 #include "fvs/util/image.h"
+#include "fvs/util/image_resize.h"
 
 namespace fvs {
 
@@ -45,9 +46,5 @@ struct PackSummary {
 // fewer than 2 views or a scale that leaves less than 16 pixels.
 PackSummary PackScene(const Scene& scene, const PackOptions& options,
                       const std::string& output_dir);
-
-// Area-weighted resampling (box filter of the exact pixel footprint): the right filter
-// for the 4x reduction of training images; also works for enlargements (nearest).
-Image ResizeArea(const Image& image, int width, int height);
 
 }  // namespace fvs
