@@ -8,6 +8,12 @@
 
 namespace fvs::colmap {
 
+std::string DenseWorkspace::ProxyMeshPath() const {
+  std::error_code ec;
+  const std::string refined = RefinedMeshPath();
+  return std::filesystem::is_regular_file(refined, ec) ? refined : DelaunayMeshPath();
+}
+
 void CheckDenseWorkspace(const DenseWorkspace& workspace) {
   namespace fs = std::filesystem;
   std::error_code ec;

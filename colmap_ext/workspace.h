@@ -31,6 +31,11 @@ struct DenseWorkspace {
   std::string FusedPath() const { return root + "/fused.ply"; }
   std::string FusedVisPath() const { return root + "/fused.ply.vis"; }
   std::string DelaunayMeshPath() const { return root + "/meshed-delaunay.ply"; }
+  // The Delaunay mesh refined by photo-consistency (prepare's mesh_refinement stage).
+  std::string RefinedMeshPath() const { return root + "/meshed-refined.ply"; }
+  // The proxy mesh the renderers use: the refined mesh where prepare made one, else the
+  // Delaunay mesh.
+  std::string ProxyMeshPath() const;
   std::string PoissonMeshPath() const { return root + "/meshed-poisson.ply"; }
   std::string FvsDir() const { return root + "/fvs"; }
   std::string SourceDepthPath(const std::string& name) const {

@@ -68,7 +68,7 @@ WorkspaceContents LoadWorkspace(const std::string& path) {
   Require(!model.images.empty(), w.sparse_dir, "the model has no registered images");
 
   // The prepared scene when there is a mesh; its origin is then the display origin too.
-  const std::string mesh_path = colmap::DenseWorkspace(path).DelaunayMeshPath();
+  const std::string mesh_path = colmap::DenseWorkspace(path).ProxyMeshPath();
   if (!fs::exists(mesh_path)) {
     w.render_error = mesh_path +
                      ": no proxy mesh, so nothing can be rendered (run colmap "

@@ -80,7 +80,7 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
 
   std::string third_log;
   ASSERT_EQ(RunShell(prepare, &third_log), 0) << third_log;
-  EXPECT_EQ(StagesMatching(third_log, "up to date").size(), 9u) << third_log;
+  EXPECT_EQ(StagesMatching(third_log, "up to date").size(), 10u) << third_log;
 
   // The workspace is a COLMAP dense workspace with a mesh; the held-out image is
   // registered but has no depth map and is in no stereo config.
@@ -98,13 +98,19 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
   EXPECT_TRUE(std::filesystem::exists(dir / "ws/fvs/depth/frame_0000.png.bin"));
   EXPECT_NE(ReadTextFile(dir / "ws/fvs/backdrop.json").find("\"enabled\": true"),
             std::string::npos);
+  // The refined mesh has the Delaunay mesh's faces and is what the scene renders.
+  const TriangleMesh refined = ReadPlyMesh(dir / "ws/meshed-refined.ply");
+  EXPECT_EQ(refined.faces, mesh.faces);
+  EXPECT_NE(ReadTextFile(dir / "ws/fvs/refinement.json").find("\"enabled\": true"),
+            std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir / "ws/fvs/tmp"));
 
   // The workspace moved elsewhere: every stage is still up to date, and nothing changes.
   const std::vector<std::string> outputs = {
-      "database.db",     "sfm/0/images.bin",      "sparse/images.bin",
-      "fused.ply",       "meshed-delaunay.ply",   "fvs/depth/frame_0000.png.bin",
-      "fvs/holdout.txt", "fvs/registration.json", "fvs/backdrop.json"};
+      "database.db",        "sfm/0/images.bin",      "sparse/images.bin",
+      "fused.ply",          "meshed-delaunay.ply",   "fvs/depth/frame_0000.png.bin",
+      "fvs/holdout.txt",    "fvs/registration.json", "fvs/backdrop.json",
+      "meshed-refined.ply", "fvs/refinement.json"};
   const std::string before = Fingerprint(dir / "ws", outputs);
   std::filesystem::create_directories(dir / "elsewhere");
   ASSERT_EQ(RunShell("mv " + dir / "ws" + " " + dir / "elsewhere/moved"), 0);
@@ -113,7 +119,7 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
                             dir / "elsewhere/moved" + " --holdout_images frame_0009.png";
   std::string moved_log;
   ASSERT_EQ(RunShell(moved, &moved_log), 0) << moved_log;
-  EXPECT_EQ(StagesMatching(moved_log, "up to date").size(), 9u) << moved_log;
+  EXPECT_EQ(StagesMatching(moved_log, "up to date").size(), 10u) << moved_log;
   EXPECT_TRUE(StagesMatching(moved_log, "done in").empty()) << moved_log;
   EXPECT_EQ(Fingerprint(dir / "elsewhere/moved", outputs), before);
   EXPECT_EQ(ReadTextFile(dir / "elsewhere/moved/fvs/manifest.json").find(dir.path()),

@@ -45,7 +45,7 @@ class WorkspacePreparation {
     RemoveAll(tmp_dir_);  // leftovers of a killed run: never trusted
     colmap::CreateDirectories(tmp_dir_);
     ChooseBackends(colmap::ProbeColmap());
-    StageRunner stages(Manifest::Load(ws_.ManifestPath(), c_.workspace_path), 9);
+    StageRunner stages(Manifest::Load(ws_.ManifestPath(), c_.workspace_path), 10);
     RunSfmStages(&stages);
     RunDenseStages(&stages);
     RemoveAll(tmp_dir_);
@@ -161,6 +161,9 @@ void WorkspacePreparation::RunDenseStages(StageRunner* stages) {
               {ws_.FusedPath(), ws_.FusedVisPath()}, [&] { Fuse(); });
   stages->Run("meshing", {}, builtin_mesher_ ? "builtin" : "colmap",
               {ws_.DelaunayMeshPath()}, [&] { Mesh(); });
+  stages->Run("mesh_refinement", {}, c_.refine.ToString(),
+              {fvs_dir_ + "/refinement.json"},
+              [&] { RefineProxyMesh(c_.workspace_path, c_.refine); });
   stages->Run("backdrop", {}, c_.backdrop.ToString(), {fvs_dir_ + "/backdrop.json"},
               [&] { BuildBackdrop(c_.workspace_path, c_.backdrop); });
   stages->Run("depth_cache", {}, "", {ws_.FvsDir() + "/depth"},
@@ -296,6 +299,7 @@ void PrepareWorkspaceOptions::Check() const {
   Require(stereo_max_image_size >= 0, who, "--Stereo.max_image_size must be >= 0");
   Require(fusion_min_num_pixels >= 1, who, "--Fusion.min_num_pixels must be >= 1");
   planar_prior.Check();
+  refine.Check();
   backdrop.Check();
 }
 

@@ -1,17 +1,18 @@
 // Preparing a workspace as one call: what `colmap view_synthesis_prepare` runs. Photos ->
 // ready scene: feature extraction, matching, mapping, undistortion (COLMAP), dense stereo
 // (COLMAP's when it has CUDA, else ours), fusion (COLMAP), meshing (COLMAP's when it has
-// CGAL, else ours), backdrop (what lies beyond the mesh: scene/backdrop.h), source depth
-// cache. Each stage records a fingerprint of its inputs
-// and options in W/fvs/manifest.json and is skipped when that is unchanged and its
-// outputs exist. Fingerprints chain (a stage's includes the one before it), so changing
-// an early stage re-runs everything after it. Stages write into W/fvs/tmp/ and rename
-// into place, so kill -9 at any point loses at most the stage that was running
+// CGAL, else ours), mesh refinement (mvs/mesh_refinement.h), backdrop (what lies beyond
+// the mesh: scene/backdrop.h), source depth cache. Each stage records a fingerprint of
+// its inputs and options in W/fvs/manifest.json and is skipped when that is unchanged and
+// its outputs exist. Fingerprints chain (a stage's includes the one before it), so
+// changing an early stage re-runs everything after it. Stages write into W/fvs/tmp/ and
+// rename into place, so kill -9 at any point loses at most the stage that was running
 // (stage_runner.h).
 #pragma once
 
 #include <string>
 
+#include "fvs/mvs/mesh_refinement.h"
 #include "fvs/mvs/planar_prior.h"
 #include "fvs/scene/backdrop.h"
 
@@ -32,6 +33,8 @@ struct PrepareWorkspaceOptions {
   int fusion_min_num_pixels = 5;
   // The built-in stereo's fill of textureless and unconfirmed pixels (--PlanarPrior.*).
   mvs::PlanarPriorOptions planar_prior;
+  // The mesh refined by photo-consistency (--Refine.*).
+  mvs::MeshRefinementOptions refine;
   // What lies beyond the mesh, fitted to the photos before infinity (--Backdrop.*).
   BackdropOptions backdrop;
   // Registered by SfM but kept out of stereo, fusion and meshing: a file with one image

@@ -61,7 +61,7 @@ std::string ContentHash(const std::vector<std::string>& paths, const std::string
 
 std::string WorkspaceContentHash(const std::string& workspace_path) {
   const colmap::DenseWorkspace ws(workspace_path);
-  return ContentHash({ws.SparseDir(), ws.DelaunayMeshPath(), ws.ImagesDir()},
+  return ContentHash({ws.SparseDir(), ws.ProxyMeshPath(), ws.ImagesDir()},
                      workspace_path);
 }
 

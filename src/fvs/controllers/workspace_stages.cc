@@ -1,13 +1,14 @@
 #include "fvs/controllers/workspace_stages.h"
 
-#include <filesystem>
 #include <iostream>
+#include <nlohmann/json.hpp>
+#include <set>
 
 #include "colmap_ext/image_io.h"
 #include "colmap_ext/sparse_io.h"
 #include "colmap_ext/workspace.h"
-#include "fvs/controllers/prepare_stages.h"
 #include "fvs/controllers/stage_runner.h"
+#include "fvs/eval/protocol.h"
 #include "fvs/geometry/ply.h"
 #include "fvs/scene/mesh_coverage.h"
 #include "fvs/scene/scene.h"
@@ -53,6 +54,55 @@ void RunBuiltinMesher(const std::string& workspace_path, const std::string& outp
 #endif
 }
 
+namespace {
+
+// The photos of W that are not held out, with their cameras (world frame).
+template <typename View>
+std::vector<View> ReadGeometryPhotos(const colmap::DenseWorkspace& ws) {
+  const std::set<std::string> holdout = eval::ReadHoldoutNames(ws.root);
+  const colmap::Reconstruction rec = colmap::ReadSparseModel(ws.SparseDir());
+  std::vector<View> views;
+  for (const auto& [image_id, image] : rec.images) {
+    if (holdout.count(image.name)) continue;  // never seen by the geometry
+    View v;
+    v.camera = rec.PinholeFor(image_id);
+    v.photo = colmap::ReadImage(ws.ImagePath(image.name), 3);
+    views.push_back(std::move(v));
+  }
+  return views;
+}
+
+}  // namespace
+
+void RefineProxyMesh(const std::string& workspace_path,
+                     const mvs::MeshRefinementOptions& options) {
+  options.Check();
+  const colmap::DenseWorkspace ws(workspace_path);
+  nlohmann::json json;
+  json["enabled"] = options.enabled;
+  json["options"] = options.ToString();
+  if (!options.enabled) {
+    RemoveAll(ws.RefinedMeshPath());
+    std::cerr << "mesh refinement: off\n";
+  } else {
+    const auto views = ReadGeometryPhotos<mvs::MeshRefinementView>(ws);
+    const TriangleMesh mesh = ReadPlyMesh(ws.DelaunayMeshPath());
+    const mvs::MeshRefinementResult result = mvs::RefineMesh(views, mesh, options);
+    PlyWriteOptions write;
+    write.double_precision = true;  // a scene far from the origin
+    WritePlyMesh(ws.RefinedMeshPath(), result.mesh, write);
+    std::cerr << result.Summary() << "; " << result.seconds << " s\n";
+    json["iterations"] = result.num_iterations_run;
+    json["stopped_at_time_bound"] = result.stopped_at_time_bound;
+    json["data_share"] = {result.first_data_share, result.last_data_share};
+    json["ncc"] = {result.ncc_before, result.ncc_after};
+    json["median_move_pixels"] = result.median_move_pixels;
+    json["seconds"] = result.seconds;
+  }
+  WriteFileAtomic(ws.FvsDir() + "/refinement.json",
+                  [&](std::ostream& out) { out << json.dump(2) << "\n"; });
+}
+
 void BuildBackdrop(const std::string& workspace_path, const BackdropOptions& options) {
   options.Check();
   Timer timer;
@@ -60,20 +110,8 @@ void BuildBackdrop(const std::string& workspace_path, const BackdropOptions& opt
   const std::string ply = ws.FvsDir() + "/backdrop.ply";
   BackdropFit fit;
   if (options.enabled) {
-    const std::string holdout_file = ws.FvsDir() + "/holdout.txt";
-    const std::set<std::string> holdout = std::filesystem::exists(holdout_file)
-                                              ? ParseHoldoutList(holdout_file)
-                                              : std::set<std::string>();
-    const colmap::Reconstruction rec = colmap::ReadSparseModel(ws.SparseDir());
-    std::vector<BackdropView> views;
-    for (const auto& [image_id, image] : rec.images) {
-      if (holdout.count(image.name)) continue;  // never seen by the geometry
-      BackdropView v;
-      v.camera = rec.PinholeFor(image_id);
-      v.photo = colmap::ReadImage(ws.ImagePath(image.name), 3);
-      views.push_back(std::move(v));
-    }
-    const TriangleMesh mesh = ReadPlyMesh(ws.DelaunayMeshPath());
+    const auto views = ReadGeometryPhotos<BackdropView>(ws);
+    const TriangleMesh mesh = ReadPlyMesh(ws.ProxyMeshPath());
     fit = FitBackdrop(views, mesh, options);
   }
   if (fit.mesh.faces.empty()) {
@@ -85,14 +123,17 @@ void BuildBackdrop(const std::string& workspace_path, const BackdropOptions& opt
   }
   std::cerr << (options.enabled ? fit.Summary() : "backdrop: off") << "; "
             << timer.Seconds() << " s\n";
-  WriteFileAtomic(ws.FvsDir() + "/backdrop.json", [&](std::ostream& out) {
-    out << "{\"enabled\": " << (options.enabled ? "true" : "false")
-        << ", \"directions\": " << fit.num_directions << ", \"finite\": " << fit.num_finite
-        << ", \"infinity\": " << fit.num_infinity
-        << ", \"unexplained\": " << fit.num_unexplained
-        << ", \"unseen\": " << fit.num_unseen << ", \"faces\": " << fit.mesh.faces.size()
-        << ", \"options\": \"" << options.ToString() << "\"}\n";
-  });
+  nlohmann::json json;
+  json["enabled"] = options.enabled;
+  json["directions"] = fit.num_directions;
+  json["finite"] = fit.num_finite;
+  json["infinity"] = fit.num_infinity;
+  json["unexplained"] = fit.num_unexplained;
+  json["unseen"] = fit.num_unseen;
+  json["faces"] = fit.mesh.faces.size();
+  json["options"] = options.ToString();
+  WriteFileAtomic(ws.FvsDir() + "/backdrop.json",
+                  [&](std::ostream& out) { out << json.dump(2) << "\n"; });
 }
 
 void BuildDepthCache(const std::string& workspace_path, int num_threads) {

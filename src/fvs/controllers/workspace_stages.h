@@ -7,6 +7,7 @@
 #include <string>
 
 #include "fvs/mvs/delaunay.h"
+#include "fvs/mvs/mesh_refinement.h"
 #include "fvs/mvs/patch_match_stereo.h"
 #include "fvs/scene/backdrop.h"
 
@@ -23,8 +24,16 @@ void RunBuiltinStereo(const std::string& workspace_path,
 void RunBuiltinMesher(const std::string& workspace_path, const std::string& output_path,
                       const mvs::DelaunayMeshingOptions& options);
 
+// Refines W/meshed-delaunay.ply by photo-consistency (mvs/mesh_refinement.h) against the
+// photos of W that are not held out (W/fvs/holdout.txt): W/meshed-refined.ply, which the
+// renderers then use (DenseWorkspace::ProxyMeshPath), and its summary
+// W/fvs/refinement.json. Disabled, it removes W/meshed-refined.ply. Throws fvs::Error for
+// an unusable workspace.
+void RefineProxyMesh(const std::string& workspace_path,
+                     const mvs::MeshRefinementOptions& options);
+
 // Fits the backdrop (scene/backdrop.h) to the photos of W that are not held out
-// (W/fvs/holdout.txt) around W/meshed-delaunay.ply: W/fvs/backdrop.ply (world frame; no
+// (W/fvs/holdout.txt) around the proxy mesh: W/fvs/backdrop.ply (world frame; no
 // file when nothing was kept) and its summary W/fvs/backdrop.json. Throws fvs::Error for
 // an unusable workspace.
 void BuildBackdrop(const std::string& workspace_path, const BackdropOptions& options);

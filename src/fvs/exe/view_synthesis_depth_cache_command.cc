@@ -1,7 +1,8 @@
 // colmap view_synthesis_depth_cache --workspace_path W: renders the depth of every source
-// view from W/meshed-delaunay.ply into W/fvs/depth/ (reusing what is current). The last
-// stage of view_synthesis_prepare; on its own after a mesh was replaced. Prints how much
-// of the photos the mesh covers and writes it per view to W/fvs/depth/coverage.json.
+// view from the proxy mesh (W/meshed-refined.ply or W/meshed-delaunay.ply) into
+// W/fvs/depth/ (reusing what is current). The last stage of view_synthesis_prepare; on
+// its own after a mesh was replaced. Prints how much of the photos the mesh covers and
+// writes it per view to W/fvs/depth/coverage.json.
 #include <string>
 
 #include "fvs/controllers/workspace_stages.h"

@@ -6,6 +6,8 @@
 // options of COLMAP's delaunay_mesher (--DelaunayMeshing.*, same names and defaults), for
 // the COLMAP builds that lack CGAL (Debian's). Bad input: one error line, exit 1, no
 // output.
+#include <filesystem>
+#include <iostream>
 #include <string>
 
 #include "colmap_ext/workspace.h"
@@ -16,6 +18,8 @@
 
 namespace fvs {
 namespace {
+
+namespace fs = std::filesystem;
 
 int RunViewSynthesisMesher(int argc, char** argv) {
   std::string workspace_path;
@@ -66,10 +70,16 @@ int RunViewSynthesisMesher(int argc, char** argv) {
   options.AddDefault("DelaunayMeshing.num_threads", &o.num_threads,
                      "threads (-1: all cores)");
   if (!options.Parse(argc, argv)) return 0;
-  if (output_path.empty()) {
-    output_path = colmap::DenseWorkspace(workspace_path).DelaunayMeshPath();
-  }
+  const colmap::DenseWorkspace ws(workspace_path);
+  if (output_path.empty()) output_path = ws.DelaunayMeshPath();
   o.Check();
+  if (output_path == ws.DelaunayMeshPath() && fs::exists(ws.RefinedMeshPath())) {
+    // A refinement of the mesh being replaced would be rendered instead of the new one.
+    std::cerr << "Removing " << ws.RefinedMeshPath()
+              << " (it refines the mesh being replaced; view_synthesis_prepare refines "
+                 "the new one)\n";
+    fs::remove(ws.RefinedMeshPath());
+  }
 
   RunBuiltinMesher(workspace_path, output_path, o);
   return 0;

@@ -1,8 +1,8 @@
 // colmap view_synthesis_prepare --image_path P --workspace_path W
 //
 // Photos -> ready scene: SfM, undistortion, dense stereo, fusion, meshing, backdrop,
-// source depth cache, each stage skipped when it is current and a killed run resumed: PrepareWorkspace
-// (controllers/prepare_workspace.h) does the work and states the rules.
+// source depth cache, each stage skipped when it is current and a killed run resumed:
+// PrepareWorkspace (controllers/prepare_workspace.h) does the work and states the rules.
 #include "fvs/controllers/prepare_workspace.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/stereo_flags.h"
@@ -53,6 +53,28 @@ int RunPrepare(int argc, char** argv) {
   options.AddDefault("Backdrop.max_colour_std", &o.backdrop.max_colour_std,
                      "directions whose colours disagree more at every radius are "
                      "left to infinity");
+  options.AddDefault("Refine.enabled", &o.refine.enabled,
+                     "move the mesh's vertices to where the photos agree "
+                     "(mvs/mesh_refinement.h)");
+  options.AddDefault("Refine.max_image_size", &o.refine.max_image_size,
+                     "longest side of the photos at the finest level");
+  options.AddDefault("Refine.num_levels", &o.refine.num_levels,
+                     "levels coarse to fine, the photo size halved per level");
+  options.AddDefault("Refine.num_iterations", &o.refine.num_iterations,
+                     "searches along the normals per level");
+  options.AddDefault("Refine.patch_size", &o.refine.patch_size,
+                     "samples per side of the compared patch (odd)");
+  options.AddDefault("Refine.search_steps", &o.refine.search_steps,
+                     "offsets of half a pixel tried on each side of a vertex");
+  options.AddDefault("Refine.num_sources", &o.refine.num_sources,
+                     "photos compared with each vertex's reference photo");
+  options.AddDefault("Refine.min_ncc", &o.refine.min_ncc,
+                     "mean NCC a vertex's best offset must reach to count");
+  options.AddDefault("Refine.smoothness", &o.refine.smoothness,
+                     "weight of each mesh edge in the regularisation (data weight <= 1)");
+  options.AddDefault("Refine.max_seconds", &o.refine.max_seconds,
+                     "time bound of the refinement (it stops after the iteration that "
+                     "crosses it)");
   options.AddDefault(
       "Mesher.backend", &o.mesher_backend,
       "auto (builtin: COLMAP's algorithm with SfM points), colmap, builtin");
@@ -68,8 +90,9 @@ int RunPrepare(int argc, char** argv) {
 
 }  // namespace
 
-FVS_REGISTER_COMMAND("view_synthesis_prepare",
-                     "photos -> ready scene (SfM, stereo, fusion, mesh, backdrop, depth cache)",
-                     RunPrepare);
+FVS_REGISTER_COMMAND(
+    "view_synthesis_prepare",
+    "photos -> ready scene (SfM, stereo, fusion, mesh, backdrop, depth cache)",
+    RunPrepare);
 
 }  // namespace fvs

@@ -22,12 +22,12 @@
 // infinity_margin: a textureless background agrees at every radius, and a finite surface
 // close behind the object keeps the sources' occlusion test consistent there (the
 // issue's "fit what the photos support before falling back to infinity, and let the
-// infinity warp's own colour disagreement decide when it is wrong"). A direction whose
-// best colours disagree by more than max_colour_std (its background is not explained by
-// any radius) or that fewer than min_views photos see is dropped, and left to infinity.
-// Explained means: the colours agree within max_colour_std at the typical (median)
-// radius, a textureless background, or the best radius is a distinct minimum (at most
-// half the typical std) within max_colour_std, a textured surface. Hypotheses are
+// infinity warp's own colour disagreement decide when it is wrong"). A finite radius is
+// kept only where it explains the colours: they agree within max_colour_std at the
+// typical (median) radius, a textureless background, or the best radius is a distinct
+// minimum (at most half the typical std) within max_colour_std, a textured surface. A
+// direction no radius explains, or that fewer than min_views photos see, is dropped and
+// left to infinity. Hypotheses are
 // compared only when seen by at least half as many photos as the most seen one (a
 // point few photos see agrees by that alone), and the variance is the unbiased one.
 // The log-radii are median-filtered over each vertex's neighbours; faces with a dropped

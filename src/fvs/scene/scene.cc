@@ -16,11 +16,13 @@ namespace fvs {
 
 namespace {
 
-void CheckMesh(const TriangleMesh& mesh, const std::string& subject) {
+// `what` names the mesh in the message: "the proxy mesh", "the backdrop".
+void CheckMesh(const TriangleMesh& mesh, const std::string& subject,
+               const std::string& what = "the proxy mesh") {
   Require(!mesh.vertices.empty() && !mesh.faces.empty(), subject,
-          "the proxy mesh has no triangles");
+          what + " has no triangles");
   for (const auto& v : mesh.vertices) {
-    Require(v.allFinite(), subject, "the proxy mesh has a non-finite vertex");
+    Require(v.allFinite(), subject, what + " has a non-finite vertex");
   }
 }
 
@@ -127,7 +129,7 @@ Scene Scene::Load(const std::string& workspace_path, const SceneLoadOptions& opt
           "workspace folder does not exist");
   Require(std::filesystem::is_directory(workspace.SparseDir()), workspace.SparseDir(),
           "no sparse model (run colmap image_undistorter or view_synthesis_prepare)");
-  const std::string mesh_path = workspace.DelaunayMeshPath();
+  const std::string mesh_path = workspace.ProxyMeshPath();
   Require(std::filesystem::is_regular_file(mesh_path), mesh_path,
           "no proxy mesh (run colmap view_synthesis_prepare or view_synthesis_mesher)");
 
@@ -149,9 +151,7 @@ Scene Scene::Load(const std::string& workspace_path, const SceneLoadOptions& opt
   const std::string backdrop_path = workspace.FvsDir() + "/backdrop.ply";
   if (std::filesystem::is_regular_file(backdrop_path)) {
     scene.backdrop_ = ReadPlyMesh(backdrop_path);
-    for (const auto& v : scene.backdrop_.vertices) {
-      Require(v.allFinite(), backdrop_path, "the backdrop has a non-finite vertex");
-    }
+    CheckMesh(scene.backdrop_, backdrop_path, "the backdrop");
     for (Eigen::Vector3d& x : scene.backdrop_.vertices) x -= scene.origin_;
   }
 

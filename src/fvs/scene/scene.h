@@ -37,7 +37,8 @@ struct SceneLoadOptions {
 
 class Scene {
  public:
-  // Loads W/sparse (via ReadSparseModel), W/meshed-delaunay.ply, the backdrop
+  // Loads W/sparse (via ReadSparseModel), the proxy mesh (W/meshed-refined.ply where
+  // prepare refined it, else W/meshed-delaunay.ply), the backdrop
   // W/fvs/backdrop.ply when prepare fitted one (scene/backdrop.h), and the source depth
   // cache (computing what is missing or stale). Throws fvs::Error naming what is missing
   // or bad.
