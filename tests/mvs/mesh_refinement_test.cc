@@ -101,6 +101,20 @@ TEST(MeshRefinementTest, MovesAProxyAFewPixelsOffOntoTheWall) {
   EXPECT_FALSE(result.stopped_at_time_bound);
 }
 
+TEST(MeshRefinementTest, SubdividesACoarseProxyAndStillMovesItOntoTheWall) {
+  const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  const auto photos = Photos(Wall(kWallY, 0.02, origin), 6, origin);
+  const TriangleMesh proxy = Wall(kWallY - 0.15, 0.4, origin);
+  MeshRefinementOptions options = SmallOptions();
+  options.max_edge_pixels = 8;
+  const MeshRefinementResult result = RefineMesh(photos, proxy, options);
+  EXPECT_GT(result.num_vertices_added, 4 * proxy.vertices.size()) << result.Summary();
+  EXPECT_EQ(result.mesh.colors.size(), result.mesh.vertices.size());
+  EXPECT_LT(MeanWallError(result.mesh, origin), 0.2 * 0.15) << result.Summary();
+  options.max_vertices = static_cast<int>(proxy.vertices.size());
+  EXPECT_EQ(RefineMesh(photos, proxy, options).num_vertices_added, 0u);
+}
+
 TEST(MeshRefinementTest, AnExactProxyStaysOnTheWall) {
   const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   const auto photos = Photos(Wall(kWallY, 0.02, origin), 6, origin);

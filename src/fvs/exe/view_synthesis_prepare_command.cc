@@ -72,6 +72,11 @@ int RunPrepare(int argc, char** argv) {
                      "mean NCC a vertex's best offset must reach to count");
   options.AddDefault("Refine.smoothness", &o.refine.smoothness,
                      "weight of each mesh edge in the regularisation (data weight <= 1)");
+  options.AddDefault("Refine.max_edge_pixels", &o.refine.max_edge_pixels,
+                     "before each level, split edges longer than this in a photo at the "
+                     "level's size (0: no subdivision)");
+  options.AddDefault("Refine.max_vertices", &o.refine.max_vertices,
+                     "subdivide no further once the mesh has this many vertices");
   options.AddDefault("Refine.max_seconds", &o.refine.max_seconds,
                      "time bound of the refinement (it stops after the iteration that "
                      "crosses it)");

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "fvs/geometry/rasterizer.h"
+#include "fvs/mvs/mesh_subdivision.h"
 #include "fvs/util/error.h"
 #include "fvs/util/image_resize.h"
 #include "fvs/util/parallel.h"
@@ -443,6 +444,9 @@ void MeshRefinementOptions::Check() const {
           kWho, "--Refine.min_triangulation_angle must be in [0, 90) degrees");
   Require(std::isfinite(smoothness) && smoothness >= 0, kWho,
           "--Refine.smoothness must be >= 0");
+  Require(std::isfinite(max_edge_pixels) && max_edge_pixels >= 0, kWho,
+          "--Refine.max_edge_pixels must be >= 0 (0: no subdivision)");
+  Require(max_vertices >= 1, kWho, "--Refine.max_vertices must be >= 1");
   Require(smoothing_iterations >= 0, kWho, "--Refine.smoothing_iterations must be >= 0");
   Require(std::isfinite(max_seconds) && max_seconds > 0, kWho,
           "--Refine.max_seconds must be positive");
@@ -454,22 +458,24 @@ std::string MeshRefinementOptions::ToString() const {
   std::snprintf(buffer, sizeof(buffer),
                 "refine size=%d levels=%d iterations=%d patch=%d steps=%d sources=%d "
                 "ncc=%.17g peak=%.17g angle=%.17g tri=%.17g smooth=%.17g smooth_it=%d "
-                "seconds=%.17g",
+                "seconds=%.17g edge=%.17g max_vertices=%d",
                 max_image_size, num_levels, num_iterations, patch_size, search_steps,
                 num_sources, min_ncc, min_peak, max_view_angle, min_triangulation_angle,
-                smoothness, smoothing_iterations, max_seconds);
+                smoothness, smoothing_iterations, max_seconds, max_edge_pixels,
+                max_vertices);
   return buffer;
 }
 
 std::string MeshRefinementResult::Summary() const {
   char buffer[320];
   std::snprintf(buffer, sizeof(buffer),
-                "mesh refinement: %d iterations%s; vertices with a data term %.1f%% -> "
+                "mesh refinement: %d iterations%s; %zu vertices added; vertices with a "
+                "data term %.1f%% -> "
                 "%.1f%%; mean NCC of the surface %.3f -> %.3f; median move %.2f px",
                 num_iterations_run,
                 stopped_at_time_bound ? " (stopped at the time bound)" : "",
-                100 * first_data_share, 100 * last_data_share, ncc_before, ncc_after,
-                median_move_pixels);
+                num_vertices_added, 100 * first_data_share, 100 * last_data_share,
+                ncc_before, ncc_after, median_move_pixels);
   return buffer;
 }
 
@@ -493,7 +499,7 @@ MeshRefinementResult RefineMesh(const std::vector<MeshRefinementView>& views,
     level.camera = v.camera.Resized(w, h);
     finest.push_back(std::move(level));
   }
-  const Adjacency adjacency = BuildAdjacency(mesh);
+  Adjacency adjacency = BuildAdjacency(mesh);
   Progress progress("mesh refinement", options.num_levels * options.num_iterations + 2);
   result.ncc_before = MeanScore(mesh, options, &finest);
   progress.Advance();
@@ -506,6 +512,16 @@ MeshRefinementResult RefineMesh(const std::vector<MeshRefinementView>& views,
     // Moves are reported in finest-level pixels: a step is half a pixel at this level.
     const double pixels_per_step =
         0.5 * static_cast<double>(finest[0].grey.width) / views_at_level[0].grey.width;
+    if (options.max_edge_pixels > 0 &&
+        result.mesh.vertices.size() < static_cast<size_t>(options.max_vertices)) {
+      std::vector<PinholeCamera> cameras;
+      for (const LevelView& v : views_at_level) cameras.push_back(v.camera);
+      const size_t before = result.mesh.vertices.size();
+      if (SubdivideLongEdges(cameras, options.max_edge_pixels, &result.mesh) > 0) {
+        adjacency = BuildAdjacency(result.mesh);
+        result.num_vertices_added += result.mesh.vertices.size() - before;
+      }
+    }
     for (int it = 0; it < options.num_iterations; ++it) {
       RenderDepths(result.mesh, options.num_threads, &views_at_level);
       const IterationStats stats =

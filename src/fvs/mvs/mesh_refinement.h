@@ -28,8 +28,12 @@
 // precisely. max_seconds bounds the whole refinement: it stops after the iteration that
 // crosses it (refined so far is kept, and the result says so).
 //
+// Detail: with max_edge_pixels > 0, each level first splits the edges longer than that in
+// some photo at the level's size (mesh_subdivision.h), so the mesh can bend where the
+// photos show more than its vertices do.
+//
 // Stable numbers: positions are double throughout; a vertex whose search or update is not
-// finite is left where it is; faces and their order are unchanged.
+// finite is left where it is; without subdivision faces and their order are unchanged.
 #pragma once
 
 #include <string>
@@ -55,8 +59,12 @@ struct MeshRefinementOptions {
   double min_triangulation_angle = 2;  // degrees between reference and source rays
   double smoothness = 0.15;            // weight of each edge against a data weight (<= 1)
   int smoothing_iterations = 10;       // Jacobi iterations of the regularisation
-  double max_seconds = 300;            // time bound of the whole refinement
-  int num_threads = 0;                 // <= 0: DefaultNumThreads()
+  // Before each level, edges longer than this in some photo at that level are split
+  // (mesh_subdivision.h), unless the mesh has max_vertices already; 0: no subdivision.
+  double max_edge_pixels = 0;
+  int max_vertices = 2000000;
+  double max_seconds = 300;  // time bound of the whole refinement
+  int num_threads = 0;       // <= 0: DefaultNumThreads()
   void Check() const;
   // Every field that changes the result, for prepare's fingerprint (not num_threads).
   std::string ToString() const;
@@ -68,8 +76,9 @@ struct MeshRefinementView {
 };
 
 struct MeshRefinementResult {
-  TriangleMesh mesh;  // the input's faces and colours, moved vertices, no normals
+  TriangleMesh mesh;  // moved (and added) vertices, their colours, faces; no normals
   int num_iterations_run = 0;
+  size_t num_vertices_added = 0;  // by subdivision
   bool stopped_at_time_bound = false;
   // Mean NCC at the surface itself (no search) over the vertices with texture that two
   // photos see, at the finest level: of the input mesh and of the refined one.
