@@ -64,7 +64,7 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
   ASSERT_TRUE(MakeTenViewScene(colmap, dir / "scene", &log)) << log;
   const std::string prepare = colmap + " view_synthesis_prepare --image_path " +
                               dir / "scene/images" + " --workspace_path " + dir / "ws" +
-                              " --holdout_images frame_0009.png";
+                              " --holdout_images frame_0009.png --Refine.enabled 1";
   // SIGKILL part-way: 25 s is inside SfM or stereo on 2 cores.
   std::string killed_log;
   RunShell("timeout -s KILL 25 " + prepare, &killed_log);
@@ -98,7 +98,7 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
   EXPECT_TRUE(std::filesystem::exists(dir / "ws/fvs/depth/frame_0000.png.bin"));
   EXPECT_NE(ReadTextFile(dir / "ws/fvs/backdrop.json").find("\"enabled\": true"),
             std::string::npos);
-  // The refined mesh has the Delaunay mesh's faces and is what the scene renders.
+  // The refinement (off by default, on here) keeps the Delaunay mesh's faces.
   const TriangleMesh refined = ReadPlyMesh(dir / "ws/meshed-refined.ply");
   EXPECT_EQ(refined.faces, mesh.faces);
   EXPECT_NE(ReadTextFile(dir / "ws/fvs/refinement.json").find("\"enabled\": true"),
@@ -116,7 +116,8 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
   ASSERT_EQ(RunShell("mv " + dir / "ws" + " " + dir / "elsewhere/moved"), 0);
   const std::string moved = colmap + " view_synthesis_prepare --image_path " +
                             dir / "scene/images" + " --workspace_path " +
-                            dir / "elsewhere/moved" + " --holdout_images frame_0009.png";
+                            dir / "elsewhere/moved" +
+                            " --holdout_images frame_0009.png --Refine.enabled 1";
   std::string moved_log;
   ASSERT_EQ(RunShell(moved, &moved_log), 0) << moved_log;
   EXPECT_EQ(StagesMatching(moved_log, "up to date").size(), 10u) << moved_log;

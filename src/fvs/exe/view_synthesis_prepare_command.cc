@@ -55,7 +55,8 @@ int RunPrepare(int argc, char** argv) {
                      "left to infinity");
   options.AddDefault("Refine.enabled", &o.refine.enabled,
                      "move the mesh's vertices to where the photos agree "
-                     "(mvs/mesh_refinement.h)");
+                     "(mvs/mesh_refinement.h; off: it did not pay on held-out views, "
+                     "doc/real_scenes.md)");
   options.AddDefault("Refine.max_image_size", &o.refine.max_image_size,
                      "longest side of the photos at the finest level");
   options.AddDefault("Refine.num_levels", &o.refine.num_levels,
