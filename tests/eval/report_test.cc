@@ -171,6 +171,7 @@ TEST(Report, CsvRoundTripKeepsNotAvailableAndErrors) {
   rows[0].mesh_pixels = 0.625;
   rows[0].infinity_pixels = 0.25;
   rows[0].filled_pixels = 0.125;
+  rows[0].filled_seen_pixels = 0.0625;
   rows[1].error = "images/x.png: image is 4x4 but its camera is 8x6, \"bad\"";
   rows[1].psnr = rows[1].ssim = rows[1].seconds = rows[1].coverage = kNotAvailable;
   WriteResultsCsv(dir / "results.csv", rows);
@@ -185,6 +186,7 @@ TEST(Report, CsvRoundTripKeepsNotAvailableAndErrors) {
   EXPECT_DOUBLE_EQ(back[0].mesh_pixels, 0.625);
   EXPECT_DOUBLE_EQ(back[0].infinity_pixels, 0.25);
   EXPECT_DOUBLE_EQ(back[0].filled_pixels, 0.125);
+  EXPECT_DOUBLE_EQ(back[0].filled_seen_pixels, 0.0625);
   EXPECT_TRUE(std::isnan(back[1].infinity_pixels));
   EXPECT_EQ(back[1].target, rows[1].target);
   EXPECT_EQ(back[1].error, rows[1].error);
@@ -224,6 +226,21 @@ TEST(Report, ReadsResultsWithoutThePixelOriginColumns) {
   EXPECT_EQ(rows[0].height, 6);
   EXPECT_TRUE(std::isnan(rows[0].mesh_pixels));
   EXPECT_TRUE(std::isnan(rows[0].filled_pixels));
+  EXPECT_TRUE(std::isnan(rows[0].filled_seen_pixels));
+
+  // Written after the pixel-origin columns but before filled_seen_pixels.
+  testing::WriteTextFile(
+      dir / "mid.csv",
+      "scene,method,num_sources,scale,precision,protocol,target,geometry_holdout,status,"
+      "psnr,ssim,lpips,psnr_covered,ssim_covered,seconds,cpu_seconds,sources_used,"
+      "coverage,mesh_pixels,infinity_pixels,filled_pixels,width,height,error\n"
+      "room,ulr,5,1,fp32,leave_one_out,a.png,no,ok,23.5,0.8,n/a,25,0.85,0.2,0.4,5,0.9,"
+      "0.5,0.25,0.125,8,6,\n");
+  const std::vector<ViewResult> mid = ReadResultsCsv(dir / "mid.csv");
+  ASSERT_EQ(mid.size(), 1u);
+  EXPECT_DOUBLE_EQ(mid[0].filled_pixels, 0.125);
+  EXPECT_EQ(mid[0].width, 8);
+  EXPECT_TRUE(std::isnan(mid[0].filled_seen_pixels));
 }
 
 TEST(Sweep, PlansEveryCombinationAndSkipsNetworksWithoutWeights) {

@@ -66,13 +66,13 @@ TEST(ViewJournal, OtherSettingsOrOverwriteStartAfresh) {
   ViewResult r;
   const EvalConfig config = Row("x").config;
   ViewJournal(dir / "views", "settings A", false).Record(Row("a.png"), Image());
-  EXPECT_TRUE(ViewJournal(dir / "views", "settings A", false)
-                  .Find(config, "a.png", &r, nullptr));
-  EXPECT_FALSE(ViewJournal(dir / "views", "settings B", false)
-                   .Find(config, "a.png", &r, nullptr));
+  EXPECT_TRUE(
+      ViewJournal(dir / "views", "settings A", false).Find(config, "a.png", &r, nullptr));
+  EXPECT_FALSE(
+      ViewJournal(dir / "views", "settings B", false).Find(config, "a.png", &r, nullptr));
   ViewJournal(dir / "views", "settings B", false).Record(Row("a.png"), Image());
-  EXPECT_FALSE(ViewJournal(dir / "views", "settings B", true)
-                   .Find(config, "a.png", &r, nullptr));
+  EXPECT_FALSE(
+      ViewJournal(dir / "views", "settings B", true).Find(config, "a.png", &r, nullptr));
 }
 
 TEST(ViewJournal, DamagedEntryIsEvaluatedAgain) {

@@ -75,6 +75,9 @@ TEST_F(ViewSynthesisEvalTest, LeaveOneOutReportsAndShardsMerge) {
     EXPECT_NEAR(r.mesh_pixels + r.infinity_pixels + r.filled_pixels, 1.0, 2e-4) << name;
     EXPECT_NEAR(r.mesh_pixels, r.coverage, 2e-4) << name;
     EXPECT_EQ(r.infinity_pixels, 0.0) << name;
+    // What no used source covered but another allowed one sees is part of the filled.
+    EXPECT_GE(r.filled_seen_pixels, 0.0) << name;
+    EXPECT_LE(r.filled_seen_pixels, r.filled_pixels + 1e-4) << name;
   }
   EXPECT_GT(rows.at("view_002.png").psnr, 25.0);  // inside the arc
   EXPECT_GT(rows.at("view_004.png").psnr, 25.0);

@@ -10,6 +10,7 @@
 #include "fvs/eval/draw.h"
 #include "fvs/eval/metrics.h"
 #include "fvs/eval/view_journal.h"
+#include "fvs/geometry/warp.h"
 #include "fvs/render/targets.h"
 #include "fvs/scene/scene.h"
 #include "fvs/util/error.h"
@@ -54,6 +55,55 @@ void CountPixelOrigins(const RenderResult& result, ViewResult* r) {
   r->mesh_pixels = (covered - at_infinity) / n;
   r->infinity_pixels = at_infinity / n;
   r->filled_pixels = 1.0 - covered / n;
+}
+
+// The share of the render's pixels that no used source covered (filled) although some
+// source the target may use sees them: their surface point passes a source's occlusion
+// test (geometry/warp.h), or, without a surface, a source sees the direction at infinity.
+// What a better choice of sources could still cover; the rest no photo sees.
+double FilledButSeenShare(const Scene& scene, const PinholeCamera& target,
+                          const std::vector<int>& excluded, const RenderResult& result) {
+  const Image& depth = result.depth;
+  const Image& coverage = result.coverage;
+  if (depth.width != target.width || depth.height != target.height ||
+      coverage.data.size() != depth.data.size() || depth.data.empty()) {
+    return kNotAvailable;
+  }
+  const std::set<int> skip(excluded.begin(), excluded.end());
+  std::vector<int> allowed;
+  for (int i = 0; i < scene.num_views(); ++i) {
+    if (!skip.count(i)) allowed.push_back(i);
+  }
+  const WarpOptions warp;
+  int64_t seen = 0;
+  for (int y = 0; y < depth.height; ++y) {
+    for (int x = 0; x < depth.width; ++x) {
+      if (coverage.at(x, y) > 0) continue;
+      const double d = depth.at(x, y);
+      const bool surface = d > 0 && std::isfinite(d);
+      const Eigen::Vector3d ray =
+          target.R.transpose() * target.PixelToCamera(x + 0.5, y + 0.5, 1);
+      const Eigen::Vector3d point = target.Unproject(x + 0.5, y + 0.5, surface ? d : 1);
+      for (int i : allowed) {
+        const PinholeCamera& source = scene.view(i).camera;
+        const Eigen::Vector3d xc =
+            surface ? source.WorldToCamera(point) : source.R * ray;  // infinity: rotation
+        if (!(xc.z() > 0)) continue;
+        const Eigen::Vector2d uv = source.CameraToPixel(xc);
+        if (!(uv.x() >= 0 && uv.y() >= 0 && uv.x() < source.width &&
+              uv.y() < source.height))
+          continue;
+        const Image& source_depth = scene.SourceDepth(i);
+        if (surface ? SourceSeesDepth(source_depth, uv.x(), uv.y(), xc.z(),
+                                      warp.occlusion_tolerance, warp.invalid_depth)
+                    : SourceSeesInfinity(source_depth, uv.x(), uv.y())) {
+          ++seen;
+          break;
+        }
+      }
+    }
+  }
+  return static_cast<double>(seen) / depth.data.size();
 }
 
 }  // namespace
@@ -162,6 +212,8 @@ void EvaluateView(const Scene& scene, int index, const std::vector<int>& exclude
   for (float c : result.coverage.data) covered += c;
   r->coverage = covered / std::max<size_t>(1, result.coverage.data.size());
   CountPixelOrigins(result, r);
+  r->filled_seen_pixels =
+      FilledButSeenShare(scene, view.camera, view.exclude_views, result);
   Require(std::isfinite(r->psnr) && std::isfinite(r->ssim), r->target,
           "metrics are not finite (NaN or Inf in the rendered image)");
   if (!options.write_images_dir.empty()) {

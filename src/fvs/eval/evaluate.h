@@ -79,6 +79,10 @@ struct ViewResult {
   double mesh_pixels = kNotAvailable;
   double infinity_pixels = kNotAvailable;
   double filled_pixels = kNotAvailable;
+  // Of the filled pixels, those some source the target may use sees (the surface point
+  // passes its occlusion test, or it sees the direction at infinity): what a better
+  // choice of sources could still cover, as a fraction of all pixels. Issue 39's bar.
+  double filled_seen_pixels = kNotAvailable;
   int width = 0, height = 0;  // the photo's size (metrics are computed at it)
 
   bool ok() const { return error.empty(); }
@@ -103,6 +107,7 @@ struct ViewResult {
     visit("mesh_pixels", r.mesh_pixels, 4);
     visit("infinity_pixels", r.infinity_pixels, 4);
     visit("filled_pixels", r.filled_pixels, 4);
+    visit("filled_seen_pixels", r.filled_seen_pixels, 4);
     visit("width", r.width, 0);
     visit("height", r.height, 0);
   }

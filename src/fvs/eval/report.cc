@@ -1,5 +1,6 @@
 #include "fvs/eval/report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -27,16 +28,36 @@ std::vector<std::string> Columns() {
 }
 const std::vector<std::string> kColumns = Columns();
 const size_t kFirstMeasureColumn = kIdentityColumns.size();
-// Where the pixel-origin columns start; files written before them lack the three.
-constexpr size_t kFirstOriginColumn = 18;
-constexpr size_t kNumOriginColumns = 3;
+// Measure columns added after results.csv files were first written, oldest first: a
+// file may lack any trailing group of them (it was written before they existed), and
+// reads them as n/a.
+const std::vector<std::vector<std::string>> kAddedColumnGroups = {
+    {"mesh_pixels", "infinity_pixels", "filled_pixels"}, {"filled_seen_pixels"}};
 
-// The header of results.csv files written before the pixel-origin columns.
-std::vector<std::string> LegacyColumns() {
-  std::vector<std::string> legacy = kColumns;
-  legacy.erase(legacy.begin() + kFirstOriginColumn,
-               legacy.begin() + kFirstOriginColumn + kNumOriginColumns);
-  return legacy;
+// For each column of kColumns, its index in a file whose header is `header`, or -1 where
+// the file predates the column. Empty when the header is no results.csv header we wrote.
+std::vector<int> ColumnIndicesOf(const std::vector<std::string>& header) {
+  for (size_t kept = kAddedColumnGroups.size() + 1; kept-- > 0;) {
+    std::vector<std::string> missing;
+    for (size_t g = kept; g < kAddedColumnGroups.size(); ++g) {
+      missing.insert(missing.end(), kAddedColumnGroups[g].begin(),
+                     kAddedColumnGroups[g].end());
+    }
+    std::vector<std::string> expected;
+    for (const std::string& c : kColumns) {
+      if (std::find(missing.begin(), missing.end(), c) == missing.end()) {
+        expected.push_back(c);
+      }
+    }
+    if (header != expected) continue;
+    std::vector<int> indices;
+    for (const std::string& c : kColumns) {
+      const auto at = std::find(header.begin(), header.end(), c);
+      indices.push_back(at == header.end() ? -1 : static_cast<int>(at - header.begin()));
+    }
+    return indices;
+  }
+  return {};
 }
 
 std::string CsvField(const std::string& s) {
@@ -215,20 +236,20 @@ std::vector<ViewResult> ReadResultsCsv(const std::string& path) {
   std::vector<std::string> fields;
   Require(static_cast<bool>(std::getline(in, line)), path, "empty file");
   SplitCsvLine(line, &fields);
-  const bool legacy = fields == LegacyColumns();
-  Require(fields == kColumns || legacy, path,
-          "line 1: not a view_synthesis_eval results.csv header");
+  const std::vector<int> indices = ColumnIndicesOf(fields);
+  Require(!indices.empty(), path, "line 1: not a view_synthesis_eval results.csv header");
+  const size_t file_columns = fields.size();
   std::vector<ViewResult> results;
   for (int number = 2; std::getline(in, line); ++number) {
     if (line.empty() || line == "\r") continue;
     const std::string where = path + ":" + std::to_string(number);
     Require(SplitCsvLine(line, &fields), where, "unterminated quote");
-    if (legacy && fields.size() == kColumns.size() - kNumOriginColumns) {
-      fields.insert(fields.begin() + kFirstOriginColumn, kNumOriginColumns, "n/a");
-    }
-    Require(fields.size() == kColumns.size(), where,
+    Require(fields.size() == file_columns, where,
             std::to_string(fields.size()) + " fields, expected " +
-                std::to_string(kColumns.size()));
+                std::to_string(file_columns));
+    std::vector<std::string> in_file = std::move(fields);
+    fields.clear();
+    for (int i : indices) fields.push_back(i < 0 ? "n/a" : in_file[i]);
     ViewResult r;
     r.scene = fields[0];
     r.config.method = fields[1];
