@@ -4,6 +4,7 @@
 #include "colmap_ext/runner.h"
 
 #include <fcntl.h>
+#include <sys/prctl.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -132,6 +133,7 @@ ProcessResult RunProcess(const std::string& executable,
     throw Error(executable,
                 std::string("cannot create a pipe (") + std::strerror(errno) + ")");
   }
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) {
     ::close(fds[0]);
@@ -139,6 +141,11 @@ ProcessResult RunProcess(const std::string& executable,
     throw Error(executable, std::string("cannot fork (") + std::strerror(errno) + ")");
   }
   if (pid == 0) {
+    // COLMAP dies with us: a killed prepare leaves no COLMAP writing its workspace (and
+    // holding its lock, util/folder_lock.h) after it. The check after covers a parent
+    // that died before the request.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(127);
     ::dup2(fds[1], STDOUT_FILENO);
     ::dup2(fds[1], STDERR_FILENO);
     const int devnull = ::open("/dev/null", O_RDONLY);

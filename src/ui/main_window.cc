@@ -22,7 +22,10 @@
 
 #include "fvs/render/fvs_method.h"
 #include "fvs/render/method.h"
+#include "fvs/scene/photo_quality.h"
 #include "fvs/scene/scene.h"
+#include "fvs/util/error.h"
+#include "fvs/util/folder_lock.h"
 #include "ui/path_panel.h"
 #include "ui/result_panel.h"
 #include "ui/scene_view.h"
@@ -329,13 +332,32 @@ void MainWindow::ShowContents(std::shared_ptr<const WorkspaceContents> contents)
                               .arg(contents_->mesh.faces.size());
   workspace_label_->setText(summary);
   statusBar()->showMessage(QString::fromStdString(contents_->path));
+  // The GUI only reads: it opens a workspace that a prepare is still writing, and says
+  // so, since what it shows is the workspace as it was when opened.
+  const std::string holder = fvs::FolderLock::Holder(contents_->path);
+  QString photos;
+  try {
+    const fvs::PhotoQualityReport quality =
+        fvs::ReadPhotoQualityReport(fvs::PhotoQualityPath(contents_->path));
+    if (quality.num_blurry() > 0 || quality.num_with_duplicates() > 0) {
+      photos = " Photos: " + QString::fromStdString(quality.Summary()) + ".";
+    }
+  } catch (const fvs::Error& e) {
+    photos = " " + QString::fromStdString(e.what()) + ".";
+  }
+  const QString notes =
+      photos + (holder.empty()
+                    ? QString()
+                    : " Being written by " + QString::fromStdString(holder) +
+                          ": reopen it when that has ended to see the result.");
   if (contents_->can_render()) {
     ShowNote("Opened " + QString::fromStdString(contents_->path) +
              ". Navigate (left drag orbit, right drag pan, wheel zoom, WASD fly, click a "
-             "camera to look through it), then Render.");
+             "camera to look through it), then Render." +
+             notes);
   } else {
     ShowError("Rendering is not available: " +
-              QString::fromStdString(contents_->render_error));
+              QString::fromStdString(contents_->render_error) + notes);
   }
   UpdateEnabled();
 }

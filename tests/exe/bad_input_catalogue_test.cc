@@ -12,6 +12,9 @@
 //     is tolerated (it holds nothing a later run could mistake for output).
 // The table below is the catalogue; doc/reliability.md lists it with the expected lines.
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -29,6 +32,7 @@
 #include <vector>
 
 #include "colmap_ext/image_io.h"
+#include "fvs/util/folder_lock.h"
 #include "fvs/util/safetensors.h"
 #include "support/test_support.h"
 
@@ -510,6 +514,21 @@ std::vector<BadInputCase> Catalogue() {
        "view_synthesis_prepare --image_path P --workspace_path WS",
        "P/a.png",
        {"cannot read image"}},
+      {"prepare_heic_truncated",
+       [](const std::string& d) {
+         // Two good photos and a HEIC cut short (a phone's upload interrupted).
+         fs::create_directories(d + "/P");
+         fs::copy_file(d + "/W/images/frame_0000.png", d + "/P/a.png");
+         fs::copy_file(d + "/W/images/frame_0001.png", d + "/P/b.png");
+         if (RunShell("oiiotool '" + d + "/W/images/frame_0002.png' -o '" + d +
+                      "/P/c.heic'") != 0) {
+           throw std::runtime_error("oiiotool cannot write HEIC");
+         }
+         Truncate(d + "/P/c.heic", fs::file_size(d + "/P/c.heic") / 3);
+       },
+       "view_synthesis_prepare --image_path P --workspace_path WS",
+       "P/c.heic",
+       {"cannot read image"}},
       {"prepare_workspace_uncreatable",
        MakeBlockingFile,
        "view_synthesis_prepare --image_path W/images --workspace_path F/WS",
@@ -626,6 +645,71 @@ TEST_F(BadInputCatalogue, EveryCaseIsOneErrorLineNamingTheFileAndLeavesNoOutput)
     for (const std::string& change : r.changes) changes += "  " + change + "\n";
     EXPECT_TRUE(r.changes.empty()) << "files left behind or touched:\n" << changes;
   }
+}
+
+// Issue 42, item 5: a workspace being written stops a second writer at once with one
+// line naming the holder, lets readers go on, and is taken over after a kill -9. The
+// holder is a second real process (forked here, holding the lock as prepare does); the
+// contenders are the real front door.
+TEST_F(BadInputCatalogue, AFolderBeingWrittenStopsASecondWriterAndLetsReadersGoOn) {
+  TempDir root;
+  const std::string dir = root.path();
+  ASSERT_EQ(RunShell("cp -a '" + fixture_->path() + "'/W '" + dir + "'/"), 0);
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t holder = ::fork();
+  ASSERT_GE(holder, 0);
+  if (holder == 0) {
+    ::close(ready[0]);
+    try {
+      const FolderLock workspace(dir + "/W", "view_synthesis_prepare");
+      const FolderLock frames(dir + "/O", "view_synthesis");
+      if (::write(ready[1], "1", 1) != 1) ::_exit(2);
+      while (true) ::pause();
+    } catch (...) {
+      ::_exit(3);
+    }
+  }
+  ::close(ready[1]);
+  char ok = 0;
+  ASSERT_EQ(::read(ready[0], &ok, 1), 1);
+  ::close(ready[0]);
+  const std::string pid = std::to_string(holder);
+  const auto before = Snapshot(dir + "/W");
+  auto run = [&](const std::string& args, std::string* err) {
+    // In a subshell: RunShell appends 2>&1, which would send stderr to /dev/null too.
+    return RunShell("(cd '" + dir + "' && " + Colmap() + " " + args + " 2>&1 >/dev/null)",
+                    err);
+  };
+  std::string err;
+  for (const std::string args : {"view_synthesis_depth_cache --workspace_path W",
+                                 "view_synthesis_mesher --workspace_path W",
+                                 "view_synthesis_stereo --workspace_path W"}) {
+    EXPECT_EQ(run(args, &err), 1) << args << ": " << err;
+    EXPECT_EQ(err.rfind("ERROR: W: in use by colmap view_synthesis_prepare (process " +
+                            pid + ", since ",
+                        0),
+              0u)
+        << args << ": " << err;
+    EXPECT_EQ(err.find('\n'), err.size() - 1) << "one line: " << err;
+  }
+  EXPECT_EQ(
+      run("view_synthesis --workspace_path W --output_path O --interpolate 1", &err), 1);
+  EXPECT_NE(err.find("ERROR: O: in use by colmap view_synthesis (process " + pid),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(before, Snapshot(dir + "/W")) << "a refused writer touched the workspace";
+  // Readers of W writing elsewhere go on.
+  EXPECT_EQ(
+      run("view_synthesis --workspace_path W --output_path O2 --interpolate 1", &err), 0)
+      << err;
+  EXPECT_EQ(run("view_synthesis_eval --workspace_path W --output_path E2", &err), 0)
+      << err;
+
+  ::kill(holder, SIGKILL);
+  ::waitpid(holder, nullptr, 0);
+  EXPECT_EQ(run("view_synthesis_depth_cache --workspace_path W", &err), 0) << err;
+  EXPECT_FALSE(fs::exists(dir + "/W/.colmap-fvs.lock")) << "taken over and released";
 }
 
 }  // namespace

@@ -80,7 +80,7 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
 
   std::string third_log;
   ASSERT_EQ(RunShell(prepare, &third_log), 0) << third_log;
-  EXPECT_EQ(StagesMatching(third_log, "up to date").size(), 10u) << third_log;
+  EXPECT_EQ(StagesMatching(third_log, "up to date").size(), 11u) << third_log;
 
   // The workspace is a COLMAP dense workspace with a mesh; the held-out image is
   // registered but has no depth map and is in no stereo config.
@@ -110,7 +110,7 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
       "database.db",        "sfm/0/images.bin",      "sparse/images.bin",
       "fused.ply",          "meshed-delaunay.ply",   "fvs/depth/frame_0000.png.bin",
       "fvs/holdout.txt",    "fvs/registration.json", "fvs/backdrop.json",
-      "meshed-refined.ply", "fvs/refinement.json"};
+      "meshed-refined.ply", "fvs/refinement.json",   "fvs/photo_quality.json"};
   const std::string before = Fingerprint(dir / "ws", outputs);
   std::filesystem::create_directories(dir / "elsewhere");
   ASSERT_EQ(RunShell("mv " + dir / "ws" + " " + dir / "elsewhere/moved"), 0);
@@ -120,7 +120,7 @@ TEST(PrepareEndToEnd, KilledRunResumesWithoutRedoingFinishedStages) {
                             " --holdout_images frame_0009.png --Refine.enabled 1";
   std::string moved_log;
   ASSERT_EQ(RunShell(moved, &moved_log), 0) << moved_log;
-  EXPECT_EQ(StagesMatching(moved_log, "up to date").size(), 10u) << moved_log;
+  EXPECT_EQ(StagesMatching(moved_log, "up to date").size(), 11u) << moved_log;
   EXPECT_TRUE(StagesMatching(moved_log, "done in").empty()) << moved_log;
   EXPECT_EQ(Fingerprint(dir / "elsewhere/moved", outputs), before);
   EXPECT_EQ(ReadTextFile(dir / "elsewhere/moved/fvs/manifest.json").find(dir.path()),

@@ -149,6 +149,45 @@ TEST(RenderTest, AdaptiveKRendersWithTheSourcesThatAddCoverage) {
   EXPECT_EQ(RenderWith("nearest", scene, view, adaptive).sources.size(), 1u);
 }
 
+// Photos prepare found blurry (SceneView::blurry) rank after every sharp source: with a
+// fixed K the target's two nearest views, both blurry, give way to sharp ones; with
+// use_blurry_sources they are chosen as before.
+TEST(RenderTest, BlurrySourcesRankAfterEverySharpOne) {
+  const TriangleMesh mesh = MakeTestWorldMesh();
+  std::vector<SceneView> views = testing::ArcViews(12, 96, 72);
+  views[4].blurry = views[6].blurry = true;
+  Scene scene = Scene::FromWorld(views, mesh);
+  for (int i = 0; i < scene.num_views(); ++i) {
+    scene.SetSourceImage(i, RenderGroundTruth(mesh, views[i].camera));
+  }
+  TargetView view;
+  view.camera = scene.view(5).camera;
+  view.exclude_views = {5};
+  RenderOptions options;
+  options.num_sources = 3;
+  auto uses = [](const RenderResult& r, int index) {
+    for (const SourceScore& s : r.sources) {
+      if (s.view_index == index) return true;
+    }
+    return false;
+  };
+  options.use_blurry_sources = true;
+  const RenderResult all = RenderWith("ulr", scene, view, options);
+  ASSERT_EQ(all.sources.size(), 3u);
+  EXPECT_TRUE(uses(all, 4) && uses(all, 6)) << "the nearest views see the most";
+  options.use_blurry_sources = false;
+  const RenderResult sharp = RenderWith("ulr", scene, view, options);
+  ASSERT_EQ(sharp.sources.size(), 3u);
+  EXPECT_FALSE(uses(sharp, 4) || uses(sharp, 6));
+  ExpectFiniteResult(sharp);
+  // Only blurry views see the target: they are still used.
+  for (int i = 0; i < scene.num_views(); ++i) {
+    if (i != 4 && i != 6 && i != 5) view.exclude_views.push_back(i);
+  }
+  const RenderResult last_resort = RenderWith("ulr", scene, view, options);
+  EXPECT_EQ(last_resort.sources.size(), 2u);
+}
+
 TEST(RenderTest, TargetCoincidingWithASourceReproducesIt) {
   const Scene scene = MakeTestScene(4, 64, 48);
   TargetView view;

@@ -21,7 +21,8 @@ bool IsImageExtension(std::string ext) {
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return std::tolower(c); });
   return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".tif" ||
-         ext == ".tiff" || ext == ".bmp" || ext == ".ppm" || ext == ".pgm";
+         ext == ".heic" || ext == ".heif" || ext == ".tiff" || ext == ".bmp" ||
+         ext == ".ppm" || ext == ".pgm";
 }
 
 }  // namespace

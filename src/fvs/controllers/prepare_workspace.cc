@@ -10,6 +10,7 @@
 #include "colmap_ext/runner.h"
 #include "colmap_ext/sparse_io.h"
 #include "colmap_ext/workspace.h"
+#include "fvs/controllers/photo_import.h"
 #include "fvs/controllers/prepare_stages.h"
 #include "fvs/controllers/sfm_steps.h"
 #include "fvs/controllers/stage_runner.h"
@@ -37,7 +38,8 @@ class WorkspacePreparation {
   explicit WorkspacePreparation(const PrepareWorkspaceOptions& options)
       : c_(Absolute(options)),
         holdout_(ParseHoldoutList(options.holdout_images)),
-        ws_(c_.workspace_path) {}
+        ws_(c_.workspace_path),
+        image_path_(c_.image_path) {}
 
   void Run() {
     CheckPhotos();
@@ -45,11 +47,16 @@ class WorkspacePreparation {
     RemoveAll(tmp_dir_);  // leftovers of a killed run: never trusted
     colmap::CreateDirectories(tmp_dir_);
     ChooseBackends(colmap::ProbeColmap());
-    StageRunner stages(Manifest::Load(ws_.ManifestPath(), c_.workspace_path), 10);
+    StageRunner stages(Manifest::Load(ws_.ManifestPath(), c_.workspace_path),
+                       photos_.needed() ? 12 : 11);
     RunSfmStages(&stages);
     RunDenseStages(&stages);
     RemoveAll(tmp_dir_);
     ReportRegistration(registration_path_, holdout_);
+    // Every run, not only the one that measured it: a blurry photo is never silent.
+    std::cerr << "Photos: "
+              << ReadPhotoQualityReport(PhotoQualityPath(c_.workspace_path)).Summary()
+              << "\n";
     std::cerr << "Scene ready: " << c_.workspace_path << "\n";
   }
 
@@ -74,10 +81,15 @@ class WorkspacePreparation {
     // COLMAP skips a photo it cannot read and aborts later (an empty file made its
     // matcher fail a CHECK): every photo's header is read here, before the workspace is
     // touched.
-    for (const std::string& name : images_) {
-      int width = 0, height = 0;
-      colmap::ReadImageSize(JoinPaths(c_.image_path, name), &width, &height);
-    }
+    photos_ = PlanPhotoImport(c_.image_path, images_);
+    if (!photos_.needed()) return;
+    // From here on the photos are those COLMAP reads, under their names there.
+    image_path_ = fvs_dir_ + "/photos";
+    images_.clear();
+    for (const PlannedPhoto& p : photos_.photos) images_.push_back(p.name);
+    std::set<std::string> holdout;
+    for (const std::string& name : holdout_) holdout.insert(photos_.NameOf(name));
+    holdout_ = holdout;
   }
 
   void ChooseBackends(const colmap::ColmapCapabilities& caps) {
@@ -116,8 +128,12 @@ class WorkspacePreparation {
   void Mesh();
 
   const PrepareWorkspaceOptions c_;
-  const std::set<std::string> holdout_;
+  std::set<std::string> holdout_;  // names as COLMAP reads them (PlannedPhoto::name)
   const colmap::DenseWorkspace ws_;
+  // The folder COLMAP reads the photos from: the user's, or W/fvs/photos where some
+  // photo had to be converted (photo_import.h).
+  std::string image_path_;
+  PhotoImportPlan photos_;
   const std::string fvs_dir_ = ws_.FvsDir();
   const std::string tmp_dir_ = fvs_dir_ + "/tmp";
   const std::string threads_ = std::to_string(c_.num_threads);
@@ -131,9 +147,22 @@ class WorkspacePreparation {
 };
 
 void WorkspacePreparation::RunSfmStages(StageRunner* stages) {
-  stages->Run("feature_extraction", {c_.image_path},
+  if (photos_.needed()) {
+    stages->Run("photo_import", {c_.image_path}, "", {image_path_}, [&] {
+      std::cerr << "  " << photos_.num_converted() << " of " << photos_.photos.size()
+                << " photos turned upright or converted from HEIF into " << image_path_
+                << "\n";
+      ImportPhotos(photos_, c_.image_path, tmp_dir_ + "/photos");
+      MoveIntoPlace(tmp_dir_ + "/photos", image_path_);
+    });
+  }
+  // One camera per device where the photos come from several (single_camera): the
+  // fingerprint of a one-device folder is what it was before cameras were counted.
+  const size_t cameras = c_.single_camera ? photos_.CameraGroups().size() : 0;
+  stages->Run("feature_extraction", {image_path_},
               c_.camera_model + " single=" + std::to_string(c_.single_camera) +
-                  " size=" + std::to_string(c_.max_image_size),
+                  " size=" + std::to_string(c_.max_image_size) +
+                  (cameras > 1 ? " cameras=" + std::to_string(cameras) : ""),
               {database_}, [&] { ExtractFeatures(); });
   stages->Run("matching", {}, matcher_, {database_}, [&] {
     std::cerr << "  " << matcher_ << " matching: " << matcher_reason_ << "\n";
@@ -168,17 +197,51 @@ void WorkspacePreparation::RunDenseStages(StageRunner* stages) {
               [&] { BuildBackdrop(c_.workspace_path, c_.backdrop); });
   stages->Run("depth_cache", {}, "", {ws_.FvsDir() + "/depth"},
               [&] { BuildDepthCache(c_.workspace_path, -1); });
+  // Last, so that adding it left the fingerprints of the stages before unchanged.
+  stages->Run("photo_quality", {}, c_.photo_quality.ToString(),
+              {PhotoQualityPath(c_.workspace_path)}, [&] {
+                WritePhotoQualityReport(
+                    PhotoQualityPath(c_.workspace_path),
+                    MeasurePhotoQuality(c_.workspace_path, c_.photo_quality));
+              });
 }
 
 void WorkspacePreparation::ExtractFeatures() {
   // A database left by a killed extraction is incomplete: start over.
   const std::string tmp_db = tmp_dir_ + "/database.db";
-  colmap::RunColmap({"feature_extractor", "--database_path", tmp_db, "--image_path",
-                     c_.image_path, "--ImageReader.camera_model", c_.camera_model,
-                     "--ImageReader.single_camera", c_.single_camera ? "1" : "0",
-                     "--SiftExtraction.use_gpu", gpu_, "--SiftExtraction.max_image_size",
-                     std::to_string(c_.max_image_size), "--SiftExtraction.num_threads",
-                     threads_});
+  RemoveAll(tmp_db);
+  std::vector<std::string> args = {"feature_extractor",
+                                   "--database_path",
+                                   tmp_db,
+                                   "--image_path",
+                                   image_path_,
+                                   "--ImageReader.camera_model",
+                                   c_.camera_model,
+                                   "--ImageReader.single_camera",
+                                   c_.single_camera ? "1" : "0",
+                                   "--SiftExtraction.use_gpu",
+                                   gpu_,
+                                   "--SiftExtraction.max_image_size",
+                                   std::to_string(c_.max_image_size),
+                                   "--SiftExtraction.num_threads",
+                                   threads_};
+  const std::vector<std::vector<std::string>> groups = photos_.CameraGroups();
+  if (!c_.single_camera || groups.size() == 1) {
+    colmap::RunColmap(args);
+  } else {
+    // Photos of several devices (EXIF make, model, lens, focal length, size): one
+    // extraction per device into the same database, each making its own shared camera.
+    std::cerr << "  " << groups.size() << " cameras (by EXIF make, model, lens, focal "
+              << "length and size): one COLMAP camera each\n";
+    const std::string list = tmp_dir_ + "/camera_images.txt";
+    args.insert(args.end(), {"--image_list_path", list});
+    for (const std::vector<std::string>& group : groups) {
+      WriteFileAtomic(list, [&](std::ostream& o) {
+        for (const std::string& name : group) o << name << "\n";
+      });
+      colmap::RunColmap(args);
+    }
+  }
   MoveIntoPlace(tmp_db, database_);
 }
 
@@ -193,22 +256,21 @@ void WorkspacePreparation::MatchIntoDatabase(const std::string& type) {
 
 void WorkspacePreparation::Map() {
   const int total = static_cast<int>(images_.size());
-  MappedModel best =
-      MapLargestModel(c_.image_path, database_, tmp_dir_ + "/sfm", threads_);
+  MappedModel best = MapLargestModel(image_path_, database_, tmp_dir_ + "/sfm", threads_);
   const bool retry = ShouldRetryExhaustive(matcher_, best.registered, total);
   if (retry) {
     std::cerr << "  registered " << best.registered << " of " << total << " images after "
               << matcher_ << " matching: matching every pair and mapping again\n";
     MatchIntoDatabase("exhaustive");
     const MappedModel second =
-        MapLargestModel(c_.image_path, database_, tmp_dir_ + "/sfm_exhaustive", threads_);
+        MapLargestModel(image_path_, database_, tmp_dir_ + "/sfm_exhaustive", threads_);
     if (second.registered > best.registered) best = second;
   }
   if (best.path.empty() || best.registered < 3) {
-    throw Error(c_.image_path, "SfM registered " + std::to_string(best.registered) +
-                                   " of " + std::to_string(total) +
-                                   " images: too few for view synthesis (photos need "
-                                   "more overlap and texture)");
+    throw Error(image_path_, "SfM registered " + std::to_string(best.registered) +
+                                 " of " + std::to_string(total) +
+                                 " images: too few for view synthesis (photos need "
+                                 "more overlap and texture)");
   }
   std::cerr << "  registered " << best.registered << " of " << total << " images\n";
   WriteRegistrationReport(registration_path_, images_, best.path, matcher_, retry);
@@ -219,7 +281,7 @@ void WorkspacePreparation::Map() {
 void WorkspacePreparation::Undistort() {
   const std::string out = tmp_dir_ + "/undistorted";
   colmap::CreateDirectories(out);
-  colmap::RunColmap({"image_undistorter", "--image_path", c_.image_path, "--input_path",
+  colmap::RunColmap({"image_undistorter", "--image_path", image_path_, "--input_path",
                      sfm_model_, "--output_path", out, "--output_type", "COLMAP",
                      "--max_image_size", std::to_string(c_.max_image_size)});
   const colmap::Reconstruction rec = colmap::ReadSparseModel(out + "/sparse");
@@ -300,6 +362,7 @@ void PrepareWorkspaceOptions::Check() const {
   Require(fusion_min_num_pixels >= 1, who, "--Fusion.min_num_pixels must be >= 1");
   planar_prior.Check();
   refine.Check();
+  photo_quality.Check();
   backdrop.Check();
 }
 

@@ -2,7 +2,9 @@
 // ready scene: feature extraction, matching, mapping, undistortion (COLMAP), dense stereo
 // (COLMAP's when it has CUDA, else ours), fusion (COLMAP), meshing (COLMAP's when it has
 // CGAL, else ours), mesh refinement (mvs/mesh_refinement.h), backdrop (what lies beyond
-// the mesh: scene/backdrop.h), source depth cache. Each stage records a fingerprint of
+// the mesh: scene/backdrop.h), source depth cache, photo quality (blurry and duplicate
+// photos: scene/photo_quality.h). HEIC and stored-rotated photos are first written
+// upright into W/fvs/photos (photo_import.h). Each stage records a fingerprint of
 // its inputs and options in W/fvs/manifest.json and is skipped when that is unchanged and
 // its outputs exist. Fingerprints chain (a stage's includes the one before it), so
 // changing an early stage re-runs everything after it. Stages write into W/fvs/tmp/ and
@@ -15,6 +17,7 @@
 #include "fvs/mvs/mesh_refinement.h"
 #include "fvs/mvs/planar_prior.h"
 #include "fvs/scene/backdrop.h"
+#include "fvs/scene/photo_quality.h"
 
 namespace fvs {
 
@@ -37,6 +40,8 @@ struct PrepareWorkspaceOptions {
   mvs::MeshRefinementOptions refine;
   // What lies beyond the mesh, fitted to the photos before infinity (--Backdrop.*).
   BackdropOptions backdrop;
+  // Blurry and near-duplicate photos (--PhotoQuality.*).
+  PhotoQualityOptions photo_quality;
   // Registered by SfM but kept out of stereo, fusion and meshing: a file with one image
   // name per line, or a comma-separated list.
   std::string holdout_images;

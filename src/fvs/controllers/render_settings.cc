@@ -6,6 +6,7 @@
 
 #include "colmap_ext/workspace.h"
 #include "fvs/render/method.h"
+#include "fvs/scene/photo_quality.h"
 #include "fvs/util/hash.h"
 
 namespace fvs {
@@ -61,7 +62,9 @@ std::string ContentHash(const std::vector<std::string>& paths, const std::string
 
 std::string WorkspaceContentHash(const std::string& workspace_path) {
   const colmap::DenseWorkspace ws(workspace_path);
-  return ContentHash({ws.SparseDir(), ws.ProxyMeshPath(), ws.ImagesDir()},
+  // The photo quality report decides which sources rank last; absent, it adds nothing.
+  return ContentHash({ws.SparseDir(), ws.ProxyMeshPath(), ws.ImagesDir(),
+                      PhotoQualityPath(workspace_path)},
                      workspace_path);
 }
 
@@ -84,6 +87,7 @@ std::string RenderSettingsJson(const RenderTargetsOptions& o) {
   json["stable_source_order"] = o.render.stable_source_order;
   json["temporal_blend"] = o.temporal.temporal_blend;
   json["fill_holes"] = o.render.fill_holes;
+  if (o.render.use_blurry_sources) json["use_blurry_sources"] = true;
   // Tiles change the network's context at their seams.
   if (TraitsOfMethod(o.method).needs_weights) {
     json["precision"] = o.render.precision;

@@ -12,6 +12,10 @@ void AddRenderEngineFlags(OptionManager* options, RenderOptions* render) {
   options->AddDefault("fill_holes", &render->fill_holes,
                       "fill pixels no source sees from the covered pixels around them "
                       "(0: leave them black; reports count them either way)");
+  options->AddDefault(
+      "use_blurry_sources", &render->use_blurry_sources,
+      "rank the photos prepare found blurry (W/fvs/photo_quality.json) as "
+      "any other source (0: only where no sharp photo sees)");
   options->AddDefault("device", &render->device,
                       "network methods: auto (CUDA when there is one), cpu or cuda");
   options->AddDefault("feature_cache_mb", &render->feature_cache_mb,

@@ -12,6 +12,7 @@
 #include "fvs/controllers/render_targets.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/render_flags.h"
+#include "fvs/util/folder_lock.h"
 #include "fvs/util/option_manager.h"
 
 namespace fvs {
@@ -116,6 +117,7 @@ int RunViewSynthesis(int argc, char** argv) {
   AddNetworkFlags(&options, &o);
   AddSequenceFlags(&options, &o);
   if (!options.Parse(argc, argv)) return 0;
+  const FolderLock lock(o.output_path, "view_synthesis", o.shard);
   PrintRenderTargetsSummary(o, RunRenderTargets(o));
   return 0;
 }

@@ -7,6 +7,7 @@
 
 #include "fvs/controllers/workspace_stages.h"
 #include "fvs/exe/command_registry.h"
+#include "fvs/util/folder_lock.h"
 #include "fvs/util/option_manager.h"
 
 namespace fvs {
@@ -21,6 +22,7 @@ int RunDepthCache(int argc, char** argv) {
   options.AddRequired("workspace_path", &workspace_path, "dense workspace");
   options.AddDefault("num_threads", &num_threads, "-1 = all cores");
   if (!options.Parse(argc, argv)) return 0;
+  const FolderLock lock(workspace_path, "view_synthesis_depth_cache");
   BuildDepthCache(workspace_path, num_threads);
   return 0;
 }

@@ -12,6 +12,7 @@
 #include "fvs/controllers/evaluation.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/render_flags.h"
+#include "fvs/util/folder_lock.h"
 #include "fvs/util/option_manager.h"
 
 namespace fvs {
@@ -89,6 +90,7 @@ int RunViewSynthesisEval(int argc, char** argv) {
   AddSweepAndReportFlags(&options, &o);
   AddRenderEngineFlags(&options, &o.render);
   if (!options.Parse(argc, argv)) return 0;
+  const FolderLock lock(o.output_path, "view_synthesis_eval", o.shard);
   const EvaluationResult result = RunEvaluation(o);
   PrintEvaluationSummary(o, result);
   RequireNoFailedViews(o, result);

@@ -8,6 +8,7 @@
 #include "fvs/exe/command_registry.h"
 #include "fvs/render/fvs_method.h"
 #include "fvs/train/finetune.h"
+#include "fvs/util/folder_lock.h"
 #include "fvs/util/option_manager.h"
 
 namespace fvs {
@@ -38,6 +39,7 @@ int RunViewSynthesisFinetune(int argc, char** argv) {
   options.AddDefault("Finetune.learning_rate", &o.learning_rate, "Adam step size");
   options.AddDefault("Finetune.num_threads", &o.num_threads, "<= 0: all cores");
   if (!options.Parse(argc, argv)) return 0;
+  const FolderLock lock(o.workspace_path, "view_synthesis_finetune");
   if (o.model_path.empty()) o.model_path = ShippedModelPath(o.variant);
   const FinetuneSummary s = RunFinetune(o);
   if (s.interrupted) return 130;  // a checkpoint was written: run again to go on

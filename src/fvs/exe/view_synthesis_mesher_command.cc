@@ -14,6 +14,7 @@
 #include "fvs/controllers/workspace_stages.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/mvs/delaunay.h"
+#include "fvs/util/folder_lock.h"
 #include "fvs/util/option_manager.h"
 
 namespace fvs {
@@ -73,6 +74,8 @@ int RunViewSynthesisMesher(int argc, char** argv) {
   const colmap::DenseWorkspace ws(workspace_path);
   if (output_path.empty()) output_path = ws.DelaunayMeshPath();
   o.Check();
+  const FolderLock lock(fs::path(output_path).parent_path().string(),
+                        "view_synthesis_mesher");
   if (output_path == ws.DelaunayMeshPath() && fs::exists(ws.RefinedMeshPath())) {
     // A refinement of the mesh being replaced would be rendered instead of the new one.
     std::cerr << "Removing " << ws.RefinedMeshPath()

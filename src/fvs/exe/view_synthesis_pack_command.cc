@@ -7,6 +7,7 @@
 #include "fvs/exe/command_registry.h"
 #include "fvs/scene/scene.h"
 #include "fvs/train/pack.h"
+#include "fvs/util/folder_lock.h"
 #include "fvs/util/option_manager.h"
 
 namespace fvs {
@@ -28,6 +29,7 @@ int RunViewSynthesisPack(int argc, char** argv) {
                      "relative depth tolerance of the overlap ranking");
   options.AddDefault("num_threads", &num_threads, "-1 = all cores");
   if (!options.Parse(argc, argv)) return 0;
+  const FolderLock lock(output_path, "view_synthesis_pack");
   pack.num_threads = num_threads;
   pack.Check();
   SceneLoadOptions load;

@@ -6,6 +6,7 @@
 #include "fvs/controllers/prepare_workspace.h"
 #include "fvs/exe/command_registry.h"
 #include "fvs/exe/stereo_flags.h"
+#include "fvs/util/folder_lock.h"
 #include "fvs/util/option_manager.h"
 
 namespace fvs {
@@ -53,6 +54,15 @@ int RunPrepare(int argc, char** argv) {
   options.AddDefault("Backdrop.max_colour_std", &o.backdrop.max_colour_std,
                      "directions whose colours disagree more at every radius are "
                      "left to infinity");
+  options.AddDefault("PhotoQuality.blur_ratio", &o.photo_quality.blur_ratio,
+                     "a photo whose sharpness is below this times the set's median is "
+                     "blurry: a source of last resort (0: none is)");
+  options.AddDefault("PhotoQuality.duplicate_distance",
+                     &o.photo_quality.duplicate_distance,
+                     "near-duplicates: centres closer than this times the median "
+                     "spacing of the photos ...");
+  options.AddDefault("PhotoQuality.duplicate_degrees", &o.photo_quality.duplicate_degrees,
+                     "... looking within this many degrees of each other");
   options.AddDefault("Refine.enabled", &o.refine.enabled,
                      "move the mesh's vertices to where the photos agree "
                      "(mvs/mesh_refinement.h; off: it did not pay on held-out views, "
@@ -90,6 +100,7 @@ int RunPrepare(int argc, char** argv) {
       "a file with one name per line, or a comma-separated list");
   options.AddDefault("num_threads", &o.num_threads, "-1 = all cores");
   if (!options.Parse(argc, argv)) return 0;
+  const FolderLock lock(o.workspace_path, "view_synthesis_prepare");
   PrepareWorkspace(o);
   return 0;
 }

@@ -13,6 +13,7 @@
 #include "fvs/exe/stereo_flags.h"
 #include "fvs/mvs/patch_match_stereo.h"
 #include "fvs/util/error.h"
+#include "fvs/util/folder_lock.h"
 #include "fvs/util/option_manager.h"
 
 namespace fvs {
@@ -77,6 +78,7 @@ int RunViewSynthesisStereo(int argc, char** argv) {
   options.AddDefault(p + "num_threads", &pm.num_threads, "-1 = all cores");
   options.AddDefault(p + "seed", &seed, "random seed (>= 0)");
   if (!options.Parse(argc, argv)) return 0;
+  const FolderLock lock(workspace_path, "view_synthesis_stereo");
   Require(workspace_format == "COLMAP", "workspace_format",
           "only COLMAP workspaces are supported, got '" + workspace_format + "'");
   Require(seed >= 0, p + "seed", "must be >= 0");

@@ -8,6 +8,7 @@
 #include "fvs/render/targets.h"
 #include "fvs/synthetic/generate.h"
 #include "fvs/util/error.h"
+#include "fvs/util/folder_lock.h"
 #include "fvs/util/option_manager.h"
 #include "fvs/util/progress.h"
 
@@ -46,6 +47,7 @@ int RunViewSynthesisSynthetic(int argc, char** argv) {
   options.AddDefault("SyntheticScene.plain_walls", &scene.plain_walls,
                      "walls, floor and ceiling of one plain colour each (textureless)");
   if (!options.Parse(argc, argv)) return 0;
+  const FolderLock lock(output_path, "view_synthesis_synthetic");
   Require(seed >= 0, "SyntheticScene.seed", "must be >= 0, got " + std::to_string(seed));
   scene.seed = static_cast<uint64_t>(seed);
   scene.Check();

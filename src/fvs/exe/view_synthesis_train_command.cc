@@ -6,6 +6,7 @@
 
 #include "fvs/exe/command_registry.h"
 #include "fvs/train/train_options.h"
+#include "fvs/util/folder_lock.h"
 
 namespace fvs {
 namespace {
@@ -13,6 +14,7 @@ namespace {
 int RunViewSynthesisTrain(int argc, char** argv) {
   TrainOptions options;
   if (!ParseTrainOptions(argc, argv, 2, &options)) return 0;
+  const FolderLock lock(options.output_path, "view_synthesis_train");
   const TrainSummary summary = RunTraining(options);
   // 130 as a shell reports an interrupted program: a checkpoint was written, run again.
   return summary.interrupted ? 130 : 0;

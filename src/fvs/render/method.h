@@ -61,6 +61,10 @@ struct RenderOptions {
   // covered pixels around them (util/hole_filling.h) instead of black; coverage and
   // confidence stay 0 there.
   bool fill_holes = true;
+  // Photos prepare found blurry (SceneView::blurry) rank after every other source: taken
+  // only for pixels no sharp photo sees (scene/photo_quality.h). true: ranked as any
+  // other.
+  bool use_blurry_sources = false;
   // Network methods: where and in what precision the network runs. device: auto (CUDA
   // when this build and machine have it, else the CPU), cpu or cuda. precision: fp32,
   // bf16 or fp16 (fp16 on CUDA only: LibTorch's CPU convolutions have none). Warping

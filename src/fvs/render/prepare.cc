@@ -48,14 +48,19 @@ PreparedTarget PrepareTarget(const Scene& scene, const TargetView& target,
       RankSources(scene, target.camera, prepared.depth, selection);
   const bool hysteresis =
       options.source_hysteresis > 0 && !target.preferred_sources.empty();
-  // The hysteresis reorders the ranking; the choice (top K or adaptive) follows it.
-  prepared.sources = ChooseSources(
-      ranking,
+  // The hysteresis reorders the ranking, blurry photos go last; the choice (top K or
+  // adaptive) follows that order.
+  std::vector<SourceScore> order =
       hysteresis ? ApplySourceHysteresis(ranking.ranked, target.preferred_sources,
                                          options.source_hysteresis,
                                          static_cast<int>(ranking.ranked.size()))
-                 : ranking.ranked,
-      selection);
+                 : ranking.ranked;
+  if (!options.use_blurry_sources) {
+    std::stable_partition(order.begin(), order.end(), [&](const SourceScore& s) {
+      return !scene.view(s.view_index).blurry;
+    });
+  }
+  prepared.sources = ChooseSources(ranking, order, selection);
   if (options.stable_source_order) {
     std::sort(prepared.sources.begin(), prepared.sources.end(),
               [](const SourceScore& a, const SourceScore& b) {

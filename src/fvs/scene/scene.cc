@@ -9,6 +9,7 @@
 #include "fvs/geometry/rasterizer.h"
 #include "fvs/scene/backdrop.h"
 #include "fvs/scene/depth_cache.h"
+#include "fvs/scene/photo_quality.h"
 #include "fvs/util/error.h"
 #include "fvs/util/progress.h"
 
@@ -144,6 +145,12 @@ Scene Scene::Load(const std::string& workspace_path, const SceneLoadOptions& opt
     v.camera_id = image.camera_id;
     v.camera = reconstruction.PinholeFor(image_id);
     views.push_back(std::move(v));
+  }
+  const PhotoQualityReport quality =
+      ReadPhotoQualityReport(PhotoQualityPath(workspace_path));
+  for (const PhotoQuality& q : quality.photos) {
+    if (!q.blurry) continue;
+    for (SceneView& v : views) v.blurry = v.blurry || v.name == q.name;
   }
   const TriangleMesh mesh = ReadPlyMesh(mesh_path);
   CheckMesh(mesh, mesh_path);

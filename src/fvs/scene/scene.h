@@ -27,6 +27,9 @@ struct SceneView {
   uint32_t image_id = 0;   // COLMAP image id (0 for in-memory scenes)
   uint32_t camera_id = 0;  // COLMAP camera id (0 for in-memory scenes)
   PinholeCamera camera;    // scene-centred
+  // prepare found the photo blurry (W/fvs/photo_quality.json, scene/photo_quality.h):
+  // the renderers use it as a source of last resort.
+  bool blurry = false;
 };
 
 struct SceneLoadOptions {
