@@ -5,6 +5,7 @@
 #include "ui/main_window.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <QAction>
 #include <QApplication>
@@ -25,7 +26,9 @@
 #include "colmap_ext/image_io.h"
 #include "fvs/path/camera_path.h"
 #include "fvs/path/video.h"
+#include "fvs/scene/photo_quality.h"
 #include "fvs/synthetic/generate.h"
+#include "fvs/util/folder_lock.h"
 #include "support/test_support.h"
 #include "ui/image_view.h"
 #include "ui/path_panel.h"
@@ -294,6 +297,30 @@ TEST_F(MainWindowTest, ErrorsShowInTheWindowWhichStaysUsable) {
   ASSERT_TRUE(WaitIdle());
   EXPECT_TRUE(window_->last_render() != nullptr) << window_->message().toStdString();
   EXPECT_FALSE(window_->message_is_error());
+}
+
+// Issue 42: the GUI only reads, so it opens a workspace another process is writing and
+// names the writer; and it repeats prepare's line on blurry and duplicate photos.
+TEST_F(MainWindowTest, NamesAWriterOfTheWorkspaceAndTheBlurryPhotos) {
+  TempDir copy;
+  ASSERT_EQ(
+      testing::RunShell("cp -a '" + workspace_->path() + "'/. '" + copy.path() + "'/"),
+      0);
+  PhotoQualityReport quality;
+  quality.median_sharpness = 0.01;
+  quality.photos.push_back({"frame_0003.png", 0.001, 0.1, true, {}});
+  WritePhotoQualityReport(PhotoQualityPath(copy.path()), quality);
+  const FolderLock writer(copy.path(), "view_synthesis_prepare");
+  OpenWorkspace(copy.path());
+  ASSERT_NE(window_->contents(), nullptr) << window_->message().toStdString();
+  const std::string message = window_->message().toStdString();
+  EXPECT_NE(message.find("1 of 1 photos blurry: frame_0003.png (10 % of the median)"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("Being written by colmap view_synthesis_prepare (process " +
+                         std::to_string(::getpid())),
+            std::string::npos)
+      << message;
 }
 
 TEST_F(MainWindowTest, CameraPathIsBuiltSavedLoadedAndRendered) {
