@@ -160,11 +160,9 @@ for spec in "${SCENES[@]}"; do
     FVS_QUIET=1 "$COLMAP" view_synthesis_pack --workspace_path "$ws" --scale 0.5 \
       --output_path "$OUT/$name.headroom/packed" > "$OUT/$name.headroom/log" 2>&1 &&
     echo "$OUT/$name.headroom/packed" > "$OUT/$name.headroom/list.txt" &&
-    FVS_QUIET=1 "$COLMAP" view_synthesis_train --Train.headroom 1 \
-      --scene_list "$OUT/$name.headroom/list.txt" "${LPIPS_ARGS[@]}" \
-      --val_scene_list "$OUT/$name.headroom/list.txt" --Train.holdout_targets 1 \
-      --Train.headroom_methods ulr,oracle_pixel,oracle_patch8 \
-      --output_path "$OUT/$name.headroom" >> "$OUT/$name.headroom/log" 2>&1 &&
+    "$BIN/fvs_headroom_main" --val_scene_list "$OUT/$name.headroom/list.txt" \
+      "${LPIPS_ARGS[@]}" --holdout_targets 1 --methods ulr,oracle_pixel,oracle_patch8 \
+      --quiet 1 --output_path "$OUT/$name.headroom" >> "$OUT/$name.headroom/log" 2>&1 &&
     touch "$OUT/$name.headroom/done" || echo "  headroom failed: $OUT/$name.headroom/log"
   fi
 done

@@ -9,6 +9,7 @@
 
 #include "fvs/geometry/warp.h"
 #include "fvs/net/image_tensor.h"
+#include "fvs/train/train_options.h"
 #include "fvs/util/error.h"
 #include "fvs/util/hole_filling.h"
 #include "fvs/util/safetensors.h"
@@ -443,6 +444,19 @@ void TrainingSampler::SetState(const std::string& state) {
   s >> rng;
   Require(!s.fail(), "checkpoint", "malformed sampler state");
   rng_ = rng;
+}
+
+std::vector<PackedScene> LoadPackedScenes(const std::string& list, int min_views, int k) {
+  std::vector<PackedScene> scenes;
+  for (const std::string& folder : ReadSceneList(list)) {
+    PackedScene s = LoadPackedScene(folder);
+    Require(s.num_views() >= min_views, folder,
+            "has " + std::to_string(s.num_views()) + " views; training with " +
+                std::to_string(k) + " sources needs at least " +
+                std::to_string(min_views) + " (listed in " + list + ")");
+    scenes.push_back(std::move(s));
+  }
+  return scenes;
 }
 
 }  // namespace fvs

@@ -39,6 +39,11 @@ struct PackedScene {
 // depths >= 0, overlap in [0,1]); throws fvs::Error naming the file.
 PackedScene LoadPackedScene(const std::string& folder);
 
+// Every scene of a scene list (ReadSceneList, train_options.h), each with at least
+// `min_views` views (training with k sources needs k + 1); throws fvs::Error naming the
+// folder and the list otherwise.
+std::vector<PackedScene> LoadPackedScenes(const std::string& list, int min_views, int k);
+
 // Leave-one-out: the up to k views of highest overlap[target] (> 0 only), best first,
 // ties by index; never the target itself nor a held-out view.
 std::vector<int> SelectTrainingSources(const PackedScene& scene, int target, int k);

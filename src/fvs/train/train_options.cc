@@ -175,17 +175,6 @@ void AddTrainOptions(OptionManager* options, TrainOptions* o) {
   options->AddDefault("Train.occlusion_tolerance", &o->occlusion_tolerance,
                       "relative depth tolerance of a valid warp");
   options->AddDefault(
-      "Train.headroom", &o->headroom,
-      "only measure ulr and the per-pixel and global oracles on the validation "
-      "views (M/headroom.csv), no training");
-  options->AddDefault("Train.headroom_choice", &o->headroom_choice,
-                      "with --Train.headroom: per-pixel choice models fitted on the "
-                      "--scene_list targets, as rows: HIDDEN:l1|l2:all|local,... "
-                      "(e.g. 0:l1:all,16:l2:local)");
-  options->AddDefault("Train.headroom_methods", &o->headroom_methods,
-                      "with --Train.headroom: only the methods whose names start with "
-                      "one of these comma-separated prefixes (empty = all)");
-  options->AddDefault(
       "Train.benchmark", &o->benchmark,
       "only the render benchmark: validation views of --val_scene_list rendered at "
       "--Train.bench_sizes, K in --Train.bench_ks, --Train.bench_precisions "

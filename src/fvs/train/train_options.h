@@ -67,17 +67,6 @@ struct TrainOptions {
   double occlusion_tolerance = 0.01;  // warp validity, relative (reference: 1%)
   int num_threads = 0;                // CPU threads for LibTorch; <= 0: default
   bool quiet = false;                 // no progress lines (tests)
-  // Only measure the headroom of the validation scenes (train/headroom.h) into
-  // M/headroom.csv; no training.
-  bool headroom = false;
-  // With headroom: also fit per-pixel choice models (train/choice_evidence.h) to the
-  // target views of --scene_list and add their blends as rows. Comma-separated specs
-  // HIDDEN:LOSS:CHANNELS, LOSS l1 or l2, CHANNELS all or local (e.g.
-  // "0:l1:all,16:l2:local"); empty: none.
-  std::string headroom_choice;
-  // With headroom: only the methods whose names start with one of these comma-separated
-  // prefixes (e.g. "ulr,oracle_patch8,stereo"); empty = all.
-  std::string headroom_methods;
   // Only the trainer-only render benchmark (train/render_benchmark.h): renders
   // validation views of --val_scene_list with the network (--Train.init_weights, else a
   // fresh --Train.variant: timing only) and ulr, into M/render_benchmark.csv; no

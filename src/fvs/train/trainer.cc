@@ -17,7 +17,6 @@
 #include "fvs/net/image_tensor.h"
 #include "fvs/net/lpips_weights.h"
 #include "fvs/net/precision.h"
-#include "fvs/train/headroom.h"
 #include "fvs/train/packed_render.h"
 #include "fvs/train/render_benchmark.h"
 #include "fvs/util/atomic_file.h"
@@ -81,19 +80,6 @@ class StopSignals {
   void (*old_int_)(int);
   void (*old_term_)(int);
 };
-
-std::vector<PackedScene> LoadScenes(const std::string& list, int min_views, int k) {
-  std::vector<PackedScene> scenes;
-  for (const std::string& folder : ReadSceneList(list)) {
-    PackedScene s = LoadPackedScene(folder);
-    Require(s.num_views() >= min_views, folder,
-            "has " + std::to_string(s.num_views()) + " views; training with " +
-                std::to_string(k) + " sources needs at least " +
-                std::to_string(min_views) + " (listed in " + list + ")");
-    scenes.push_back(std::move(s));
-  }
-  return scenes;
-}
 
 std::string FormatDuration(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "?";
@@ -256,9 +242,9 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
   LoadLpipsWeights();
 
   const int k = options_.num_sources;
-  train_scenes_ = LoadScenes(options_.scene_list, k + 1, k);
+  train_scenes_ = LoadPackedScenes(options_.scene_list, k + 1, k);
   if (!options_.val_scene_list.empty()) {
-    val_scenes_ = LoadScenes(options_.val_scene_list, 2, k);
+    val_scenes_ = LoadPackedScenes(options_.val_scene_list, 2, k);
   }
 
   torch::manual_seed(static_cast<uint64_t>(options_.seed));
@@ -575,71 +561,7 @@ TrainSummary Trainer::Run() {
   return summary;
 }
 
-namespace {
-
-TrainSummary RunHeadroom(const TrainOptions& options) {
-  Require(!options.val_scene_list.empty(), "view_synthesis_train",
-          "--Train.headroom needs --val_scene_list");
-  Timer timer;
-  ConfigureTorchThreads();
-  if (options.num_threads > 0) torch::set_num_threads(options.num_threads);
-  const ModelConfig config = ModelConfig::ForVariant(options.variant);
-  const SampleWarpOptions warp =
-      SampleWarpOptionsFor(config, options.occlusion_tolerance);
-  ImageDistance distance;
-  const std::string lpips_path = ResolveLpipsPath(options.lpips_path);
-  if (!lpips_path.empty()) {
-    LpipsNet lpips(lpips_path);
-    lpips->eval();
-    distance = [lpips](const torch::Tensor& a, const torch::Tensor& b) mutable {
-      torch::NoGradGuard no_grad;
-      return lpips->forward(a, b).item<double>();
-    };
-  }
-  std::vector<NamedChoiceModel> choice;
-  const std::vector<ChoiceFitOptions> fits = ParseChoiceSpecs(options.headroom_choice);
-  const std::vector<PackedScene> fit_scenes =
-      fits.empty() ? std::vector<PackedScene>()
-                   : LoadScenes(options.scene_list, 2, options.num_sources);
-  for (ChoiceFitOptions fit : fits) {
-    fit.seed = static_cast<uint64_t>(options.seed) + 1;
-    const ChoiceFit result = FitChoiceModel(fit_scenes, options.num_sources, warp,
-                                            options.holdout_targets, fit, options.quiet);
-    const std::string name = ChoiceSpecName(fit);
-    std::cout << name << ": error " << result.start_error << " (ulr) -> "
-              << result.final_error << " on " << result.pixels
-              << " pixels of the --scene_list targets\n";
-    if (fit.hidden == 0) {  // what a linear choice keys on
-      const torch::Tensor weight = result.model->first->weight.flatten();
-      for (int c = 0; c < kNumEvidence; ++c) {
-        std::cout << "  " << EvidenceChannelName(c) << " " << weight[c].item<double>()
-                  << "\n";
-      }
-    }
-    choice.push_back({name, result.model});
-  }
-  const std::vector<HeadroomRow> rows = MeasureHeadroom(
-      LoadScenes(options.val_scene_list, 2, options.num_sources), options.num_sources,
-      options.val_views, warp, distance, options.holdout_targets, choice,
-      options.headroom_methods);
-  std::filesystem::create_directories(options.output_path);
-  WriteHeadroomCsv(options.output_path + "/headroom.csv", rows);
-  for (const HeadroomRow& r : rows) {
-    std::cout << r.scene << "  " << r.method << "  " << r.views << " views  PSNR "
-              << std::fixed << std::setprecision(2) << r.psnr << "  SSIM "
-              << std::setprecision(4) << r.ssim;
-    if (r.lpips >= 0) std::cout << "  LPIPS " << r.lpips;
-    std::cout << "\n";
-  }
-  TrainSummary summary;
-  summary.seconds = timer.Seconds();
-  return summary;
-}
-
-}  // namespace
-
 TrainSummary RunTraining(const TrainOptions& options) {
-  if (options.headroom) return RunHeadroom(options);
   if (options.benchmark) return RunRenderBenchmark(options);
   return Trainer(options).Run();
 }

@@ -1,13 +1,13 @@
 // Per-view stereo at the novel view: the proxy's depth refined per pixel the way stereo
-// refines depth, not the way a blend does. The depth sweep (train/depth_sweep.h) scored
-// a depth by the sources' colour variance and failed where every depth agrees (flat and
-// dark regions, where silhouettes slid onto the backdrop) and where noise picks the
-// depth (winner-take-all per pixel). Here each candidate depth is scored by normalised
-// cross-correlation of each seeing source against the pixel's reference source (the one
-// with the most ULR weight) over a window, with windows too flat to correlate scored
-// neutral; the cost volume is smoothed by semi-global matching (four scanline
+// refines depth, not the way a blend does. The depth sweep (tools/headroom/depth_sweep.h)
+// scored a depth by the sources' colour variance and failed where every depth agrees
+// (flat and dark regions, where silhouettes slid onto the backdrop) and where noise picks
+// the depth (winner-take-all per pixel). Here each candidate depth is scored by
+// normalised cross-correlation of each seeing source against the pixel's reference source
+// (the one with the most ULR weight) over a window, with windows too flat to correlate
+// scored neutral; the cost volume is smoothed by semi-global matching (four scanline
 // directions, penalties for a step of one candidate and for larger jumps) with a prior
-// toward the proxy. A measurement of the headroom runner (train/headroom.h).
+// toward the proxy. A measurement of the headroom runner (tools/headroom/headroom.h).
 #pragma once
 
 #include <torch/torch.h>

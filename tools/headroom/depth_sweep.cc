@@ -1,4 +1,4 @@
-#include "fvs/train/depth_sweep.h"
+#include "tools/headroom/depth_sweep.h"
 
 #include <cmath>
 #include <cstdint>

@@ -2,8 +2,8 @@
 // per cent off, the sources' warped colours disagree (the "doubled" look of `ulr`); a
 // small sweep of depths around the proxy's, scored by how well the seeing sources agree
 // over a window, moves each pixel to the depth where they agree. A measurement of the
-// headroom runner (train/headroom.h), like the other photo-free blends there: it tells
-// whether depth refinement at the novel view is worth building into the renderer.
+// headroom runner (tools/headroom/headroom.h), like the other photo-free blends there: it
+// tells whether depth refinement at the novel view is worth building into the renderer.
 #pragma once
 
 #include <torch/torch.h>
@@ -37,8 +37,8 @@ torch::Tensor DepthSweepBlend(const PackedScene& scene, const TrainingSample& s,
                               const DepthSweepOptions& options,
                               torch::Tensor* chosen = nullptr);
 
-// What the sweep and the stereo (train/depth_stereo.h) share. Throws fvs::Error unless
-// `s` is a full-size sample of `scene` with ULR log-weights.
+// What the sweep and the stereo (tools/headroom/depth_stereo.h) share. Throws fvs::Error
+// unless `s` is a full-size sample of `scene` with ULR log-weights.
 void CheckRefinableSample(const PackedScene& scene, const TrainingSample& s);
 // The grid [K,h,w,2] of the sample's sources at its target's proxy depth x (1 + change)
 // (change 0: the sample's own grid); checks the sample as above.

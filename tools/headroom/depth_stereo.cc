@@ -1,4 +1,4 @@
-#include "fvs/train/depth_stereo.h"
+#include "tools/headroom/depth_stereo.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,8 +8,8 @@
 
 #include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
-#include "fvs/train/depth_sweep.h"
 #include "fvs/util/error.h"
+#include "tools/headroom/depth_sweep.h"
 
 namespace fvs {
 namespace {

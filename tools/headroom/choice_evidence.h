@@ -2,8 +2,8 @@
 // over it: issue 16's question whether cheap measurements the warp already makes tell
 // which source is right at a target pixel, where the warped colours, their agreement and
 // the ULR terms (fvs_agg's inputs) do not. A measurement tool of the headroom runner
-// (train/headroom.h): the model is fitted on training scenes and judged as a blend on
-// other views; nothing renders with it.
+// (tools/headroom/headroom.h): the model is fitted on training scenes and judged as a
+// blend on other views; nothing renders with it.
 #pragma once
 
 #include <torch/torch.h>

@@ -1,4 +1,4 @@
-#include "fvs/train/choice_evidence.h"
+#include "tools/headroom/choice_evidence.h"
 
 #include <iomanip>
 #include <iostream>

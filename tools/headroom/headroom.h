@@ -14,9 +14,10 @@
 // is a global colour or exposure difference. Beside the oracles, blends that see no
 // photo (net/consensus.h): the ULR weights cut where a source disagrees with the blend
 // (consensus_*), the sources shifted locally onto the blend before it (align_*), the
-// proxy's depth refined per pixel (sweep_*, train/depth_sweep.h; stereo_*,
-// train/depth_stereo.h), exposure matching (exposure_*) and fitted choices (choice_*).
-// Pixels no source sees are filled as the renderer fills them, the same for all.
+// proxy's depth refined per pixel (sweep_*, tools/headroom/depth_sweep.h; stereo_*,
+// tools/headroom/depth_stereo.h), exposure matching (exposure_*) and fitted choices
+// (choice_*). Pixels no source sees are filled as the renderer fills them, the same for
+// all.
 #pragma once
 
 #include <torch/torch.h>
@@ -25,8 +26,8 @@
 #include <string>
 #include <vector>
 
-#include "fvs/train/choice_evidence.h"
 #include "fvs/train/data.h"
+#include "tools/headroom/choice_evidence.h"
 
 namespace fvs {
 
@@ -43,7 +44,8 @@ struct HeadroomRow {
 // Distance of two [1,3,H,W] images in [0,1] (LPIPS); empty = not measured.
 using ImageDistance = std::function<double(const torch::Tensor&, const torch::Tensor&)>;
 
-// A blend of fitted per-pixel choice models (train/choice_evidence.h), a row each.
+// A blend of fitted per-pixel choice models (tools/headroom/choice_evidence.h), a row
+// each.
 struct NamedChoiceModel {
   std::string name;
   ChoiceModel model;

@@ -1,4 +1,4 @@
-#include "fvs/train/headroom.h"
+#include "tools/headroom/headroom.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,11 +9,11 @@
 
 #include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
-#include "fvs/train/depth_stereo.h"
-#include "fvs/train/depth_sweep.h"
 #include "fvs/train/loss.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
+#include "tools/headroom/depth_stereo.h"
+#include "tools/headroom/depth_sweep.h"
 
 namespace fvs {
 namespace {
@@ -77,12 +77,13 @@ const ConsensusOptions kConsensus[] = {{0.1, 2, 1}, {0.15, 2, 1}};
 // The sources aligned to the blend by local shifts, then blended with the ULR weights.
 const AlignOptions kAlign[] = {{2, 2, 1e-3, 1}};
 
-// The proxy's depth refined per pixel where the sources agree best (train/depth_sweep.h).
+// The proxy's depth refined per pixel where the sources agree best
+// (tools/headroom/depth_sweep.h).
 const DepthSweepOptions kSweep[] = {
     {3, 0.03, 2, 1e-4, 0}, {4, 0.06, 3, 1e-4, 0}, {2, 0.02, 4, 1e-4, 0.5}};
 
 // The same by per-view stereo: correlation cost, semi-global matching
-// (train/depth_stereo.h).
+// (tools/headroom/depth_stereo.h).
 // Settings chosen on two held-out views each of fold 0 of four training scenes; the
 // widest (+-3 %) with a large prior, and +-1 %.
 const DepthStereoOptions kStereo[] = {{4, 0.03, 3, 0.02, 0.3, 0.2, 1.0, 0.5},
