@@ -13,6 +13,7 @@
 #include "fvs/net/precision.h"
 #include "fvs/train/data.h"
 #include "fvs/train/packed_render.h"
+#include "fvs/train/trainer.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
 #include "fvs/util/machine.h"
@@ -49,33 +50,13 @@ void WriteCsv(const std::string& path, const std::vector<Row>& rows) {
 TrainSummary RunRenderBenchmark(const TrainOptions& options) {
   options.Check();
   Timer clock;
-  if (options.num_threads > 0) {
-    torch::set_num_threads(options.num_threads);
-  } else {
-    ConfigureTorchThreads();
-  }
+  ConfigureTrainingThreads(options);
   const BenchmarkGrid grid = ParseBenchmarkGrid(options);
-  if (options.device == "cuda") {
-    Require(torch::cuda::is_available(), "view_synthesis_train",
-            "--Train.device cuda, but this LibTorch sees no CUDA device");
-  }
-  const torch::Device device = (options.device == "cuda" ||
-                                (options.device == "auto" && torch::cuda::is_available()))
-                                   ? torch::Device(torch::kCUDA)
-                                   : torch::Device(torch::kCPU);
+  const torch::Device device = TrainingDevice(options);
   // A fresh network per precision (casting one back and forth would round its weights).
   ModelConfig config;
   auto make_net = [&] {
-    FvsNet net{nullptr};
-    if (!options.init_weights.empty()) {
-      net = LoadModel(options.init_weights, &config);
-    } else {
-      config = options.model_config_json.empty()
-                   ? ModelConfig::ForVariant(options.variant)
-                   : ModelConfig::FromJson(options.model_config_json);
-      torch::manual_seed(static_cast<uint64_t>(options.seed));
-      net = FvsNet(config);
-    }
+    FvsNet net = InitialNetwork(options, &config);
     net->eval();
     return net;
   };

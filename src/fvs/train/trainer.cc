@@ -213,32 +213,12 @@ bool ReadBestValidation(const std::string& folder, ValidationResult* best) {
 
 Trainer::Trainer(const TrainOptions& options) : options_(options) {
   options_.Check();
-  if (options_.num_threads > 0) {
-    torch::set_num_threads(options_.num_threads);
-  } else {
-    ConfigureTorchThreads();
-  }
-  FvsNet init{nullptr};
-  if (!options_.init_weights.empty()) {
-    // Fine-tuning: the file's own layout, whatever --Train.variant says.
-    init = LoadModel(options_.init_weights, &config_);
-  } else {
-    config_ = options_.model_config_json.empty()
-                  ? ModelConfig::ForVariant(options_.variant)
-                  : ModelConfig::FromJson(options_.model_config_json);
-  }
-  config_.Check();
-  if (options_.device == "cuda") {
-    Require(torch::cuda::is_available(), "view_synthesis_train",
-            "--Train.device cuda, but this LibTorch sees no CUDA device");
-  }
-  device_ = (options_.device == "cuda" ||
-             (options_.device == "auto" && torch::cuda::is_available()))
-                ? torch::Device(torch::kCUDA)
-                : torch::Device(torch::kCPU);
+  ConfigureTrainingThreads(options_);
+  // Before the scenes: a bad weights file should not wait for them to load.
+  net_ = InitialNetwork(options_, &config_);
+  device_ = TrainingDevice(options_);
   dtype_ = PrecisionDtype(options_.precision, "--Train.precision");
 
-  // Before the scenes: a bad weights file should not wait for them to load.
   LoadLpipsWeights();
 
   const int k = options_.num_sources;
@@ -247,8 +227,6 @@ Trainer::Trainer(const TrainOptions& options) : options_(options) {
     val_scenes_ = LoadPackedScenes(options_.val_scene_list, 2, k);
   }
 
-  torch::manual_seed(static_cast<uint64_t>(options_.seed));
-  net_ = init.is_empty() ? FvsNet(config_) : init;
   net_->to(device_);
   optimizer_ = std::make_unique<torch::optim::Adam>(
       TrainedParameters(*net_, options_.frozen),
@@ -559,6 +537,42 @@ TrainSummary Trainer::Run() {
   summary.steps_done = step_;
   summary.seconds = total.Seconds();
   return summary;
+}
+
+void ConfigureTrainingThreads(const TrainOptions& options) {
+  if (options.num_threads > 0) {
+    torch::set_num_threads(options.num_threads);
+  } else {
+    ConfigureTorchThreads();
+  }
+}
+
+torch::Device TrainingDevice(const TrainOptions& options) {
+  if (options.device == "cuda") {
+    Require(torch::cuda::is_available(), "view_synthesis_train",
+            "--Train.device cuda, but this LibTorch sees no CUDA device");
+  }
+  return (options.device == "cuda" ||
+          (options.device == "auto" && torch::cuda::is_available()))
+             ? torch::Device(torch::kCUDA)
+             : torch::Device(torch::kCPU);
+}
+
+FvsNet InitialNetwork(const TrainOptions& options, ModelConfig* config) {
+  if (!options.init_weights.empty()) {
+    FvsNet net = LoadModel(options.init_weights, config);
+    config->Check();
+    // Seeded all the same: what draws from LibTorch's generator next (the training)
+    // starts from --Train.seed either way.
+    torch::manual_seed(static_cast<uint64_t>(options.seed));
+    return net;
+  }
+  *config = options.model_config_json.empty()
+                ? ModelConfig::ForVariant(options.variant)
+                : ModelConfig::FromJson(options.model_config_json);
+  config->Check();
+  torch::manual_seed(static_cast<uint64_t>(options.seed));
+  return FvsNet(*config);
 }
 
 TrainSummary RunTraining(const TrainOptions& options) {

@@ -23,6 +23,17 @@
 
 namespace fvs {
 
+// What a run starts from, one way for the trainer, fine-tuning (a Trainer with
+// init_weights) and the render benchmark. LibTorch's threads: --Train.num_threads, else
+// ConfigureTorchThreads. The device: --Train.device, cuda checked, auto CUDA where
+// LibTorch sees one. The network: --Train.init_weights in the file's own layout whatever
+// --Train.variant says, else a fresh --Train.variant (or model_config_json) initialised
+// from --Train.seed; *config gets its layout, checked. Throw fvs::Error naming the
+// option or the file.
+void ConfigureTrainingThreads(const TrainOptions& options);
+torch::Device TrainingDevice(const TrainOptions& options);
+FvsNet InitialNetwork(const TrainOptions& options, ModelConfig* config);
+
 struct ValidationResult {
   int step = 0;
   struct Scene {
