@@ -2,6 +2,8 @@
 // scope turns on and restores LibTorch's state, a bf16 step (--Train.precision bf16) is
 // finite, keeps fp32 weights and changes them, the option parses and bad values are
 // refused, and the benchmark renders its grid into render_benchmark.csv.
+#include "fvs/net/precision.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,28 +12,21 @@
 #include <sstream>
 
 #include "fvs/net/lpips_weights.h"
-#include "fvs/net/precision.h"
 #include "fvs/train/pack.h"
 #include "fvs/train/packed_render.h"
 #include "fvs/train/trainer.h"
 #include "fvs/util/error.h"
 #include "scene/scene_fixture.h"
 #include "support/test_support.h"
+#include "train/tiny_net.h"
 
 namespace fvs {
 namespace {
 
 using testing::TempDir;
 
-const char kTinyNet[] =
-    R"({"variant": "fvs_fast", "feature_channels": 8, "encoder_channels": [8, 16, 16],
-        "encoder_convs": [1, 1, 1], "blend_channels": [8, 16, 16], "blend_convs_per_stage": 2})";
-
-// Without the colour skip and the priors the output is the network's alone, so bf16 shows.
-const char kTinyNetNoSkip[] =
-    R"({"variant": "fvs_fast", "feature_channels": 8, "encoder_channels": [8, 16, 16],
-        "encoder_convs": [1, 1, 1], "blend_channels": [8, 16, 16], "blend_convs_per_stage": 2,
-        "rgb_skip": false, "mask_prior": 0, "ulr_prior": 0})";
+using testing::kTinyNet;
+using testing::kTinyNetNoSkip;
 
 class PrecisionTest : public ::testing::Test {
  protected:

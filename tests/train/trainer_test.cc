@@ -23,21 +23,15 @@
 #include "net/lpips_fixture.h"
 #include "scene/scene_fixture.h"
 #include "support/test_support.h"
+#include "train/tiny_net.h"
 
 namespace fvs {
 namespace {
 
 using testing::TempDir;
 
-// A few thousand parameters: steps take milliseconds on 2 cores.
-const char kTinyNet[] =
-    R"({"variant": "fvs_fast", "feature_channels": 8, "encoder_channels": [8, 16, 16],
-        "encoder_convs": [1, 1, 1], "blend_channels": [8, 16, 16], "blend_convs_per_stage": 2})";
-// The same without the colour skip: it starts from noise, so its loss must fall a lot.
-const char kTinyNetNoSkip[] =
-    R"({"variant": "fvs_fast", "feature_channels": 8, "encoder_channels": [8, 16, 16],
-        "encoder_convs": [1, 1, 1], "blend_channels": [8, 16, 16], "blend_convs_per_stage": 2,
-        "rgb_skip": false, "mask_prior": 0, "ulr_prior": 0})";
+using testing::kTinyNet;
+using testing::kTinyNetNoSkip;
 
 class TrainerTest : public ::testing::Test {
  protected:
