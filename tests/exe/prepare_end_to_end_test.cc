@@ -198,6 +198,21 @@ TEST(PrepareEndToEnd, BadInputIsOneLine) {
                      &log),
             0);
   EXPECT_NE(log.find("at least 3"), std::string::npos) << log;
+  // All-black photos (issue 39 item 6): COLMAP's mapper only says it "failed to create
+  // sparse model"; prepare says why.
+  std::filesystem::create_directories(dir / "black");
+  for (const char* name : {"a.png", "b.png", "c.png", "d.png"}) {
+    colmap::WriteImage(dir / "black/" + name, Image(160, 120, 3));
+  }
+  EXPECT_EQ(RunShell(colmap + " view_synthesis_prepare --image_path " + dir / "black" +
+                         " --workspace_path " + dir / "ws_black",
+                     &log),
+            1);
+  EXPECT_NE(log.find("ERROR: " + dir / "black" +
+                     ": SfM registered no photos: 4 of 4 photos have fewer than 100 SIFT "
+                     "features"),
+            std::string::npos)
+      << log;
 }
 
 }  // namespace

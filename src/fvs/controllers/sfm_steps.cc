@@ -5,12 +5,14 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "colmap_ext/database.h"
 #include "colmap_ext/reconstruction.h"
 #include "colmap_ext/runner.h"
 #include "colmap_ext/sparse_io.h"
 #include "colmap_ext/workspace.h"
 #include "fvs/controllers/prepare_stages.h"
 #include "fvs/util/atomic_file.h"
+#include "fvs/util/error.h"
 #include "fvs/util/string_util.h"
 
 namespace fvs {
@@ -45,11 +47,49 @@ void RunMatcher(const std::string& type, const std::string& database,
   colmap::RunColmap(args);
 }
 
+namespace {
+
+// Why mapping could not start, from the database: photos with too few features (black,
+// blank, blurred, textureless), or no pair of photos that share enough of them. Empty
+// when neither explains it.
+std::string WhyMappingFound(const std::string& database) {
+  constexpr int kMinFeatures = 100;
+  colmap::DatabaseContents db;
+  try {
+    db = colmap::ReadDatabase(database);
+  } catch (const Error&) {
+    return "";
+  }
+  int featureless = 0;
+  for (const auto& [id, image] : db.images)
+    featureless += image.num_keypoints < kMinFeatures;
+  const std::string of = " of " + std::to_string(db.images.size()) + " photos";
+  if (featureless * 2 > static_cast<int>(db.images.size())) {
+    return std::to_string(featureless) + of + " have fewer than " +
+           std::to_string(kMinFeatures) +
+           " SIFT features (black, blank, blurred or textureless photos?)";
+  }
+  if (db.num_verified_pairs == 0) {
+    return "no two" + of +
+           " share enough features (photos of different places, or too little overlap?)";
+  }
+  return "";
+}
+
+}  // namespace
+
 MappedModel MapLargestModel(const std::string& image_path, const std::string& database,
                             const std::string& out, const std::string& threads) {
   colmap::CreateDirectories(out);
-  colmap::RunColmap({"mapper", "--database_path", database, "--image_path", image_path,
-                     "--output_path", out, "--Mapper.num_threads", threads});
+  try {
+    colmap::RunColmap({"mapper", "--database_path", database, "--image_path", image_path,
+                       "--output_path", out, "--Mapper.num_threads", threads});
+  } catch (const Error&) {
+    // "failed to create sparse model" says nothing of why: the database does.
+    const std::string why = WhyMappingFound(database);
+    if (why.empty()) throw;
+    throw Error(image_path, "SfM registered no photos: " + why);
+  }
   MappedModel best;
   for (const auto& entry : fs::directory_iterator(out)) {
     if (!entry.is_directory()) continue;
