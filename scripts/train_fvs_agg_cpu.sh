@@ -11,15 +11,14 @@
 # holdout reports their held-out views, scripts/ship_model.sh) and the selection scenes
 # (ethiopian_head, beer), whose held-out views the trainer validates and picks
 # checkpoints on, so that no reported view ever steers training.
-# FVS_VARIANT (fvs_agg, or fvs_agg_rel: its choice sees colours only relative to the
-# blend), FVS_TRAIN_STEPS (default 200000), FVS_RUN (the run folder under runs/, default
-# fvs_agg_h), FVS_INIT (weights a new run starts from; a run with checkpoints resumes from
-# them), FVS_CHOICE (the weight of the choice term, train/loss.h; 0 = off), FVS_LOSS and
-# FVS_LPIPS_WEIGHT (l1+ssim+lpips and 1 with the LPIPS weights), FVS_FROZEN (parameter
-# names kept at their start, --Train.frozen; e.g. agg_confidence), FVS_LR
-# (2e-4), FVS_PACK_SCALE (0.5; the real scenes' pack size, 1 = the size
-# view_synthesis_eval renders them at; other scales pack into packed_s<scale>/) and
-# FVS_PREPARE_ONLY=1 steer it.
+# FVS_VARIANT (fvs_agg; any variant view_synthesis_model_info lists), FVS_TRAIN_STEPS
+# (default 200000), FVS_RUN (the run folder under runs/, default fvs_agg_h), FVS_INIT
+# (weights a new run starts from; a run with checkpoints resumes from them), FVS_CHOICE
+# (the weight of the choice term, train/loss.h; 0 = off), FVS_LOSS and FVS_LPIPS_WEIGHT
+# (l1+ssim+lpips and 1 with the LPIPS weights), FVS_FROZEN (parameter names kept at their
+# start, --Train.frozen; e.g. agg_confidence), FVS_LR (2e-4), FVS_PACK_SCALE (0.5; the
+# real scenes' pack size, 1 = the size view_synthesis_eval renders them at; other scales
+# pack into packed_s<scale>/) and FVS_PREPARE_ONLY=1 steer it.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 DATASETS="$(realpath "${1:-../shared/datasets}")"

@@ -250,6 +250,47 @@ TEST(WeightsTest, RoundTripFp32AndFp16) {
   }
 }
 
+// Every variant left in src/fvs/net (doc/network.md) builds, renders and comes back from
+// its weights file (fp16, as shipped) rendering what it rendered. Its widths are cut
+// where it has an encoder, so that the paper's network stays small here.
+TEST(WeightsTest, EveryVariantRoundTripsThroughItsWeightsFile) {
+  TempDir dir;
+  torch::manual_seed(12);
+  const torch::Tensor images = torch::rand({3, 3, 19, 23}) * 2 - 1;
+  const torch::Tensor grid = torch::rand({3, 17, 21, 2}) * 2.2 - 1.1;
+  const torch::Tensor valid_depth = torch::ones({1, 1, 17, 21});
+  const torch::Tensor valid_warp = (torch::rand({3, 1, 17, 21}) > 0.3).to(torch::kFloat);
+  const torch::Tensor ulr = torch::log(torch::rand({3, 1, 17, 21}).clamp_min(1e-4));
+  for (const std::string& name : ModelConfig::KnownVariants()) {
+    SCOPED_TRACE(name);
+    ModelConfig config = ModelConfig::ForVariant(name);
+    if (config.feature_channels > 0) {
+      config.feature_channels = 8;
+      config.encoder_channels = {8, 12, 16};
+      config.blend_channels = {8, 12, 16, 24};
+    }
+    torch::manual_seed(13);
+    FvsNet net(config);
+    {  // random heads too, so that the weights decide the image
+      torch::NoGradGuard no_grad;
+      for (auto& p : net->parameters()) p.normal_(0, 0.1);
+    }
+    auto render = [&](FvsNet& n) {
+      n->eval();
+      torch::NoGradGuard no_grad;
+      return n->Forward(images, grid, valid_depth, valid_warp, ulr).rgb;
+    };
+    const torch::Tensor reference = render(net);
+    ASSERT_TRUE(torch::isfinite(reference).all().item<bool>());
+    const std::string path = dir / (name + ".safetensors");
+    SaveWeights(net, config, path, /*fp16=*/true);
+    ModelConfig read;
+    FvsNet loaded = LoadModel(path, &read);
+    EXPECT_EQ(read.ToJson(), config.ToJson());
+    EXPECT_LT((render(loaded) - reference).abs().max().item<float>(), 2e-2f);
+  }
+}
+
 // The files must be readable by Python's safetensors; that package cannot be installed
 // here, so a standard-library reader that applies the reference implementation's checks
 // (tests/net/read_safetensors.py) reads them and sums every tensor.

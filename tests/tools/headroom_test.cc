@@ -8,7 +8,6 @@
 #include <cmath>
 #include <string>
 
-#include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
 #include "fvs/train/data.h"
 #include "fvs/train/pack.h"
@@ -16,6 +15,7 @@
 #include "scene/scene_fixture.h"
 #include "support/test_support.h"
 #include "tools/headroom/choice_evidence.h"
+#include "tools/headroom/consensus.h"
 #include "tools/headroom/depth_stereo.h"
 #include "tools/headroom/depth_sweep.h"
 
@@ -280,6 +280,82 @@ TEST_F(HeadroomTest, DepthStereoFindsTheDepthWhereTheSourcesCorrelate) {
             PsnrOf(off.ulr, off.sample.target_rgb) + 0.1);
   options.p2 = options.p1 / 2;
   EXPECT_THROW(DepthStereoBlend(off.scene, off.sample, off.warp, options), Error);
+}
+
+// Colour consensus (tools/headroom/consensus.h): sources that agree keep their weights,
+// one that disagrees over its window loses it, and the term stays finite and at most 0
+// for any colours, tau or window. The window means: equal inside the image; at a corner
+// BoxMean counts the replicated border, BoxMeanInImage only the pixels inside.
+// SeenWeights masks before the softmax: a hidden source with a huge log-weight does not
+// take the seeing sources' weight (masking after a softmax over all left them e^-40 each,
+// and their blend black); where nothing sees, all weights and the blend are 0.
+TEST(ConsensusTest, SeenWeightsAreASoftmaxOverTheSeeingSourcesOnly) {
+  const torch::Tensor log_weights =
+      torch::tensor({40.f, 0.f, std::log(3.f)}).view({3, 1, 1, 1});
+  const torch::Tensor seen = torch::tensor({0.f, 1.f, 1.f}).view({3, 1, 1, 1});
+  const torch::Tensor w = SeenWeights(log_weights, seen).flatten();
+  EXPECT_NEAR(w[0].item<float>(), 0, 1e-7);
+  EXPECT_NEAR(w[1].item<float>(), 0.25, 1e-6);
+  EXPECT_NEAR(w[2].item<float>(), 0.75, 1e-6);
+  const torch::Tensor colours = torch::tensor({9.f, 1.f, 2.f}).view({3, 1, 1, 1});
+  EXPECT_NEAR(BlendSeen(colours, seen, log_weights).item<float>(), 1.75, 1e-6);
+  EXPECT_EQ(BlendSeen(colours, torch::zeros_like(seen), log_weights).item<float>(), 0);
+  EXPECT_EQ(SeenWeights(log_weights, torch::zeros_like(seen)).abs().sum().item<float>(),
+            0);
+}
+
+TEST(ConsensusTest, BoxMeansAgreeInsideAndDifferAtTheBorderAsDocumented) {
+  const torch::Tensor x = torch::arange(36, torch::kFloat).reshape({1, 1, 6, 6});
+  const torch::Tensor replicated = BoxMean(x, 1), inside = BoxMeanInImage(x, 1);
+  EXPECT_TRUE(torch::allclose(replicated.narrow(2, 1, 4).narrow(3, 1, 4),
+                              inside.narrow(2, 1, 4).narrow(3, 1, 4)));
+  EXPECT_NEAR(inside[0][0][0][0].item<double>(), (0 + 1 + 6 + 7) / 4.0, 1e-5);
+  EXPECT_NEAR(replicated[0][0][0][0].item<double>(), (4 * 0 + 2 * 1 + 2 * 6 + 7) / 9.0,
+              1e-5);
+  EXPECT_TRUE(torch::equal(BoxMeanInImage(x, 0), x));
+}
+
+TEST(ConsensusTest, ADisagreeingSourceLosesItsWeightAndAgreeingOnesKeepTheirs) {
+  torch::manual_seed(3);
+  const torch::Tensor base = torch::rand({1, 3, 12, 14});
+  torch::Tensor colours = base.repeat({4, 1, 1, 1});
+  const torch::Tensor seen = torch::ones({4, 1, 12, 14});
+  const torch::Tensor log_weights = torch::zeros({4, 1, 12, 14});
+  ConsensusOptions options{0.05, 2, 1};
+  EXPECT_LT(
+      ConsensusLogWeights(colours, seen, log_weights, options).abs().max().item<float>(),
+      1e-6);
+  colours[3] = 1 - colours[3];
+  const torch::Tensor term = ConsensusLogWeights(colours, seen, log_weights, options);
+  EXPECT_LT(term[3].mean().item<float>(), -5.0);
+  EXPECT_GT(term.narrow(0, 0, 3).mean().item<float>(), term[3].mean().item<float>() + 4);
+  options.tau = 0;
+  EXPECT_EQ(
+      ConsensusLogWeights(colours, seen, log_weights, options).abs().max().item<float>(),
+      0);
+  for (const double tau : {1e-6, 0.05, 1e6}) {
+    options = {tau, 4, 3};
+    const torch::Tensor t = ConsensusLogWeights(
+        colours * 1e6, seen * (torch::rand_like(seen) > 0.5), log_weights, options);
+    EXPECT_TRUE(torch::isfinite(t).all().item<bool>()) << tau;
+    EXPECT_LE(t.max().item<float>(), 0) << tau;
+  }
+}
+
+// A source the proxy put one pixel off lands back on the others after alignment.
+TEST(ConsensusTest, AlignmentMovesAShiftedSourceBackOntoTheOthers) {
+  torch::manual_seed(4);
+  const torch::Tensor base = torch::rand({1, 3, 16, 18});
+  torch::Tensor colours = base.repeat({3, 1, 1, 1});
+  colours[2] = torch::roll(base[0], {1}, {2});  // one pixel to the right
+  torch::Tensor seen = torch::ones({3, 1, 16, 18});
+  const torch::Tensor log_weights = torch::log(torch::tensor({0.45f, 0.45f, 0.1f}))
+                                        .view({3, 1, 1, 1})
+                                        .expand({3, 1, 16, 18});
+  AlignToBlend(&colours, &seen, log_weights, {2, 2, 1e-4, 1});
+  const torch::Tensor interior = (colours[2] - base[0]).narrow(1, 3, 10).narrow(2, 3, 12);
+  EXPECT_LT(interior.abs().max().item<float>(), 1e-6);
+  EXPECT_TRUE(torch::isfinite(colours).all().item<bool>());
 }
 
 }  // namespace

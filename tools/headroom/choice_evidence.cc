@@ -4,9 +4,9 @@
 #include <iostream>
 #include <sstream>
 
-#include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
 #include "fvs/util/error.h"
+#include "tools/headroom/consensus.h"
 
 namespace fvs {
 namespace {

@@ -6,9 +6,9 @@
 #include <limits>
 #include <vector>
 
-#include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
 #include "fvs/util/error.h"
+#include "tools/headroom/consensus.h"
 #include "tools/headroom/depth_sweep.h"
 
 namespace fvs {

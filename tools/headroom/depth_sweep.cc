@@ -5,9 +5,9 @@
 #include <limits>
 #include <vector>
 
-#include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
 #include "fvs/util/error.h"
+#include "tools/headroom/consensus.h"
 
 namespace fvs {
 void DepthSweepOptions::Check() const {

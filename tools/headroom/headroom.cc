@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "fvs/net/consensus.h"
 #include "fvs/net/net.h"
 #include "fvs/train/loss.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
+#include "tools/headroom/consensus.h"
 #include "tools/headroom/depth_stereo.h"
 #include "tools/headroom/depth_sweep.h"
 
@@ -71,7 +71,7 @@ torch::Tensor PatchOracle(const torch::Tensor& colours, const torch::Tensor& see
 }
 
 // Blends that see no photo: the ULR weights with the colour-consensus term
-// (net/consensus.h) at a few settings.
+// (consensus.h) at a few settings.
 const ConsensusOptions kConsensus[] = {{0.1, 2, 1}, {0.15, 2, 1}};
 
 // The sources aligned to the blend by local shifts, then blended with the ULR weights.

@@ -12,7 +12,7 @@
 // nearest the photo, which no blender can predict. The colour oracle gives the `ulr`
 // blend one gain and offset per channel fitted to the photo: the part of the error that
 // is a global colour or exposure difference. Beside the oracles, blends that see no
-// photo (net/consensus.h): the ULR weights cut where a source disagrees with the blend
+// photo (consensus.h): the ULR weights cut where a source disagrees with the blend
 // (consensus_*), the sources shifted locally onto the blend before it (align_*), the
 // proxy's depth refined per pixel (sweep_*, tools/headroom/depth_sweep.h; stereo_*,
 // tools/headroom/depth_stereo.h), exposure matching (exposure_*) and fitted choices

@@ -50,11 +50,10 @@ void ZeroInit(ConvUnit& unit) {
 }  // namespace
 
 AggregateBlenderImpl::AggregateBlenderImpl(const ModelConfig& config)
-    : ulr_prior_(config.ulr_prior), relative_inputs_(config.relative_inputs) {
+    : ulr_prior_(config.ulr_prior) {
   const int w0 = config.blend_channels[0], w1 = config.blend_channels[1];
   auto* s = &source_;
-  s_in_ = Add("agg_s_in", relative_inputs_ ? kRelativeSourceInputs : kSourceInputs, w0, 1,
-              0, s);
+  s_in_ = Add("agg_s_in", kSourceInputs, w0, 1, 0, s);
   s_down1_ = Add("agg_s_down1", w0, w1, 3, 1, s);
   s_down2_ = Add("agg_s_down2", w1, w1, 3, 1, s);
   s_mix_ = Add("agg_s_mix", w0 + w1, w0, 1, 0, s);
@@ -108,19 +107,15 @@ BlendOutput AggregateBlenderImpl::forward(const torch::Tensor& warped,
   // Per-source stack; log-weights scaled so that the floor (-9.2) is about -1.
   const double log_floor = -std::log(kUlrWeightFloor);
   const torch::Tensor difference = (warped - ulr) * v;
-  // relative_inputs: the difference over the spread replaces U, and c_k is left out. The
-  // spread's floor (about 1 % of the colour range) keeps the ratio from amplifying the
-  // noise of sources that agree.
-  std::vector<torch::Tensor> inputs = {
-      v,
-      ulr_log / log_floor,
-      ulr_weights,
-      difference,
-      relative_inputs_ ? (difference / (deviation + 0.02)).clamp(-4, 4) : per_source(ulr),
-      per_source(deviation),
-      per_source(vd),
-      per_source(share)};
-  if (!relative_inputs_) inputs.insert(inputs.begin(), colour);
+  const std::vector<torch::Tensor> inputs = {colour,
+                                             v,
+                                             ulr_log / log_floor,
+                                             ulr_weights,
+                                             difference,
+                                             per_source(ulr),
+                                             per_source(deviation),
+                                             per_source(vd),
+                                             per_source(share)};
   torch::Tensor x = torch::cat(inputs, 1);
   x = PadEven(x);
   torch::Tensor h = WithHalfResolutionContext(torch::relu(s_in_(x)), s_down1_, s_down2_,

@@ -6,9 +6,6 @@
 // not see the pixel), whether it sees it (v_k), its ULR log-weight and weight, c_k minus
 // the ULR blend U, and, the same for every source, U itself, the standard deviation of
 // the seeing sources' colours, valid_depth and the share of sources that see the pixel.
-// With config.relative_inputs (fvs_agg_rel) c_k and U are left out and c_k - U divided by
-// the standard deviation (plus a floor, clamped to +-4) joins instead: the per-source
-// stack then sees nothing of a scene's own colours, only how the sources agree.
 //   per source (shared weights, the K sources as a batch):
 //     conv1x1 (w0) -> half resolution 2 x conv3x3 (w1), up, concatenated, conv1x1 (w0)
 //     -> conv3x3 (w0) -> mean and max over the seeing sources, concatenated, conv1x1
@@ -51,10 +48,8 @@ class AggregateBlenderImpl : public torch::nn::Module {
   std::vector<const ConvUnitImpl*> PerSourceUnits() const;
   std::vector<const ConvUnitImpl*> PerTargetUnits() const;
 
-  // Input channels of the per-source stack (without and with relative_inputs) and of
-  // the refiner.
+  // Input channels of the per-source stack and of the refiner.
   static constexpr int kSourceInputs = 17;
-  static constexpr int kRelativeSourceInputs = 14;
   static constexpr int kRefinerInputs = 11;
 
  private:
@@ -62,7 +57,6 @@ class AggregateBlenderImpl : public torch::nn::Module {
                std::vector<ConvUnit>* list);
 
   double ulr_prior_;
-  bool relative_inputs_;
   std::vector<ConvUnit> source_, target_;
   ConvUnit s_in_{nullptr}, s_down1_{nullptr}, s_down2_{nullptr}, s_mix_{nullptr},
       s_context_{nullptr}, s_pool_{nullptr}, confidence_{nullptr}, correction_{nullptr};

@@ -12,6 +12,8 @@ namespace fvs {
 namespace {
 
 const char kSubject[] = "model config";
+// A field of weights files written before the variant that used it was removed.
+const char kRemovedRelativeInputs[] = "relative_inputs";
 
 std::string JoinNames(const std::vector<std::string>& names) {
   std::string s;
@@ -103,14 +105,6 @@ const Variant kVariants[] = {
     // without one loses little), statistics across the warped sources instead of a
     // recurrence, starts as the ULR blend (net/aggregate.h).
     {"fvs_agg", [](ModelConfig* c) { MakeAggregate(c); }},
-    // fvs_agg whose choice of source sees colours only relative to the blend: the
-    // confidence learned from a few scenes keyed on their colours and did not carry to
-    // unseen ones (doc/training.md, session 13).
-    {"fvs_agg_rel",
-     [](ModelConfig* c) {
-       MakeAggregate(c);
-       c->relative_inputs = true;
-     }},
 };
 
 }  // namespace
@@ -154,6 +148,17 @@ ModelConfig ModelConfig::FromJson(const std::string& text) {
   std::vector<std::string> fields;
   const ModelConfig defaults;
   ForEachField(defaults, [&](const char* name, const auto&) { fields.push_back(name); });
+  // Files written while the experimental fvs_agg_rel existed carry its switch, false in
+  // every fvs_agg file; that one is the network it names today.
+  if (j.contains(kRemovedRelativeInputs)) {
+    if (j[kRemovedRelativeInputs] != false) {
+      throw Error(kSubject,
+                  "\"relative_inputs\" belongs to the removed experimental variant "
+                  "fvs_agg_rel (doc/training.md); these weights need colmap-fvs of "
+                  "commit d1b9f5e or earlier");
+    }
+    j.erase(kRemovedRelativeInputs);
+  }
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (std::find(fields.begin(), fields.end(), it.key()) == fields.end()) {
       throw Error(kSubject, "unknown field \"" + it.key() + "\"");
@@ -185,7 +190,6 @@ void ModelConfig::Check() const {
             "the aggregate blender needs two blend_channels in [1, 4096]");
   } else {
     CheckUnet();
-    require(!relative_inputs, "relative_inputs needs the aggregate blender");
   }
   require(std::isfinite(mask_prior) && mask_prior >= 0 && mask_prior <= 30,
           "mask_prior must be in [0, 30]");

@@ -55,11 +55,6 @@ struct ModelConfig {
   // corrections to it (not in the paper; the CPU variant). The ULR settings are part of
   // the model so that a set of weights always blends from the prior it was trained with.
   double ulr_prior = 0;
-  // Aggregate blender only: the per-source stack sees a source's colour only relative to
-  // the others (its difference from the ULR blend, normalised by the spread), never the
-  // colours themselves, so its choice of source cannot key on a scene's own colours and
-  // textures (net/aggregate.h). The refiner still sees the blended colours.
-  bool relative_inputs = false;
   int ulr_num_blend = 4;
   double ulr_resolution_weight = 0.2;
 
@@ -107,7 +102,6 @@ struct ModelConfig {
     visit("rgb_skip", c.rgb_skip);
     visit("mask_prior", c.mask_prior);
     visit("ulr_prior", c.ulr_prior);
-    visit("relative_inputs", c.relative_inputs);
     visit("ulr_num_blend", c.ulr_num_blend);
     visit("ulr_resolution_weight", c.ulr_resolution_weight);
   }

@@ -1,4 +1,4 @@
-#include "fvs/net/consensus.h"
+#include "tools/headroom/consensus.h"
 
 #include "fvs/net/net.h"
 
