@@ -21,6 +21,7 @@
 #include "colmap_ext/image_io.h"
 #include "fvs/scene/photo_quality.h"
 #include "fvs/util/error.h"
+#include "fvs/util/image_resize.h"
 #include "fvs/util/machine.h"
 #include "fvs/util/string_util.h"
 
@@ -28,28 +29,6 @@ namespace fs = std::filesystem;
 using namespace fvs;
 
 namespace {
-
-Image BoxBlur(const Image& image) {
-  Image out = image;
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      for (int c = 0; c < image.channels; ++c) {
-        float sum = 0;
-        int n = 0;
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int xx = x + dx, yy = y + dy;
-            if (xx < 0 || yy < 0 || xx >= image.width || yy >= image.height) continue;
-            sum += image.at(xx, yy, c);
-            ++n;
-          }
-        }
-        out.at(x, y, c) = sum / n;
-      }
-    }
-  }
-  return out;
-}
 
 // A workspace view of a dataset folder: W/images and W/sparse as links.
 std::string AsWorkspace(const std::string& scene, const std::string& tmp) {
@@ -107,7 +86,7 @@ int main(int argc, char** argv) {
         Image image = colmap::ReadImage(JoinPaths(w + "/images", median->name));
         const double base = Sharpness(image) / median->relative;  // the median it met
         for (int passes = 1; passes <= 4; ++passes) {
-          image = BoxBlur(image);
+          image = BoxBlur(image, 1);
           if (passes == 1 || passes == 2 || passes == 4) {
             char text[32];
             std::snprintf(text, sizeof(text), "%s%.2f", blurred.empty() ? "" : " / ",

@@ -13,6 +13,7 @@
 #include "fvs/eval/report.h"
 #include "net/lpips_fixture.h"
 #include "scene/scene_fixture.h"
+#include "scene/arc_workspace_test.h"
 #include "support/test_support.h"
 
 namespace fvs {
@@ -23,13 +24,9 @@ using testing::ReadTextFile;
 using testing::RunShell;
 namespace fs = std::filesystem;
 
-class ViewSynthesisEvalTest : public ::testing::Test {
+class ViewSynthesisEvalTest : public testing::ArcWorkspaceTest {
  protected:
-  void SetUp() override {
-    ws_ = dir_ / "ws";
-    testing::WriteTestWorkspace(ws_, testing::ArcViews(7, 80, 60),
-                                testing::MakeTestWorldMesh());
-  }
+  ViewSynthesisEvalTest() : ArcWorkspaceTest(7, 80, 60) {}
   // `lpips_env`: the value of FVS_LPIPS_PATH for the run; unset when empty, so that a
   // shell's default does not change the reports.
   int Eval(const std::string& args, const std::string& out, std::string* output,
@@ -46,8 +43,6 @@ class ViewSynthesisEvalTest : public ::testing::Test {
     for (const eval::ViewResult& r : eval::ReadResultsCsv(csv)) rows[r.target] = r;
     return rows;
   }
-  testing::TempDir dir_;
-  std::string ws_;
 };
 
 TEST_F(ViewSynthesisEvalTest, LeaveOneOutReportsAndShardsMerge) {

@@ -51,12 +51,7 @@ TEST(CameraTest, ProjectionAndUnprojectionRoundTrip) {
 }
 
 TEST(CameraTest, PixelConventionIsColmaps) {
-  PinholeCamera c;
-  c.width = 4;
-  c.height = 2;
-  c.fx = c.fy = 1;
-  c.cx = 2;
-  c.cy = 1;
+  PinholeCamera c = testing::CenteredCamera(4, 2, 1);
   // The principal point at the image centre is the corner shared by the four middle
   // pixels.
   EXPECT_EQ(c.CameraToPixel({0, 0, 1}), Eigen::Vector2d(2, 1));

@@ -12,18 +12,25 @@
 
 namespace fvs::testing {
 
-// Camera at `center` looking at `target`; `up` is the world direction that appears up in
-// the image (COLMAP's image y axis points down).
-inline PinholeCamera LookAtCamera(const Eigen::Vector3d& center,
-                                  const Eigen::Vector3d& target,
-                                  const Eigen::Vector3d& up, int width, int height,
-                                  double focal) {
+// A camera of the world frame's pose (at the origin looking down +z) with square pixels
+// and the principal point at the image centre.
+inline PinholeCamera CenteredCamera(int width, int height, double focal) {
   PinholeCamera c;
   c.width = width;
   c.height = height;
   c.fx = c.fy = focal;
   c.cx = width / 2.0;
   c.cy = height / 2.0;
+  return c;
+}
+
+// Camera at `center` looking at `target`; `up` is the world direction that appears up in
+// the image (COLMAP's image y axis points down).
+inline PinholeCamera LookAtCamera(const Eigen::Vector3d& center,
+                                  const Eigen::Vector3d& target,
+                                  const Eigen::Vector3d& up, int width, int height,
+                                  double focal) {
+  PinholeCamera c = CenteredCamera(width, height, focal);
   const Eigen::Vector3d z = (target - center).normalized();
   const Eigen::Vector3d x = (-up).cross(z).normalized();
   const Eigen::Vector3d y = z.cross(x);

@@ -263,12 +263,7 @@ TEST(RasterizerTest, PerspectiveCorrectColour) {
     const Eigen::Vector3d c = color_of(p);
     quad.colors.emplace_back(c.x(), c.y(), c.z());
   }
-  PinholeCamera camera;
-  camera.width = 80;
-  camera.height = 60;
-  camera.fx = camera.fy = 50;
-  camera.cx = 40;
-  camera.cy = 30;
+  PinholeCamera camera = testing::CenteredCamera(80, 60, 50);
   RasterizeOptions options;
   options.compute_color = true;
   const RasterResult r = Rasterize(quad, camera, options);
@@ -300,12 +295,7 @@ TEST(RasterizerTest, PerspectiveCorrectColour) {
 // separately, the halves must cover disjoint pixel sets whose union is the whole image:
 // no cracks, no pixel drawn twice.
 TEST(RasterizerTest, SharedEdgesHaveNoCracksAndNoDoubleCoverage) {
-  PinholeCamera camera;
-  camera.width = 96;
-  camera.height = 64;
-  camera.fx = camera.fy = 100;
-  camera.cx = 48;
-  camera.cy = 32;
+  PinholeCamera camera = testing::CenteredCamera(96, 64, 100);
   std::mt19937 rng(9);
   for (bool jitter : {false, true}) {
     // Grid vertices at pixel positions of the image plane at depth 1 (pixel-centre hits).
@@ -359,12 +349,7 @@ TEST(RasterizerTest, ClosedSphereHasNoHolesAndMatchesTheAnalyticSphere) {
   const Eigen::Vector3d center(0.3, -0.2, 6);
   const double radius = 2;
   const TriangleMesh sphere = MakeSphere(5, radius, center);  // 20480 faces
-  PinholeCamera camera;
-  camera.width = 160;
-  camera.height = 120;
-  camera.fx = camera.fy = 100;
-  camera.cx = 80;
-  camera.cy = 60;
+  PinholeCamera camera = testing::CenteredCamera(160, 120, 100);
   const Image depth = Rasterize(sphere, camera).depth;
   // A pixel whose ray passes well inside the inscribed (chord) radius must be covered.
   const double inscribed = radius * std::cos(0.05);
@@ -403,12 +388,7 @@ TEST(RasterizerTest, FarFromTheOriginRendersAsAtTheOrigin) {
 }
 
 TEST(RasterizerTest, EmptyAwayDegenerateAndNonFinite) {
-  PinholeCamera camera;
-  camera.width = 40;
-  camera.height = 30;
-  camera.fx = camera.fy = 30;
-  camera.cx = 20;
-  camera.cy = 15;
+  PinholeCamera camera = testing::CenteredCamera(40, 30, 30);
   RasterizeOptions options;
   options.compute_color = true;
   options.compute_face_ids = true;
@@ -487,12 +467,7 @@ TEST(RasterizerTest, FaceIdsAgreeWithDepth) {
 // No NaN or Inf leaves the rasteriser: huge and tiny coordinates, a vertex at the camera
 // centre, a face seen exactly edge-on, a face entirely behind the camera.
 TEST(RasterizerTest, ExtremeGeometryStaysFinite) {
-  PinholeCamera camera;
-  camera.width = 48;
-  camera.height = 32;
-  camera.fx = camera.fy = 40;
-  camera.cx = 24;
-  camera.cy = 16;
+  PinholeCamera camera = testing::CenteredCamera(48, 32, 40);
   TriangleMesh mesh;
   mesh.vertices = {{-1e30, -1e30, 1e30},
                    {1e30, -1e30, 1e30},

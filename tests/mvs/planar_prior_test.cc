@@ -95,8 +95,9 @@ TEST(PlanarPriorTest, FillsAHoleWithTheTrueDepth) {
   {
     const int x0 = 30, y0 = 6, x1 = 130, y1 = 40;
     DepthNormalMap map = TrueMapWithHole(f, x0, y0, x1, y1);
-    const PlanarPriorStats stats = FillFromPlanarPriors(
-        f.views, 0, f.sources, f.source_depths, {}, nullptr, PlanarPriorOptions(), &map);
+    const PlanarPriorStats stats =
+        FillFromPlanarPriors(f.views, {0, f.sources, f.source_depths, {}, nullptr},
+                             PlanarPriorOptions(), &map);
     EXPECT_GE(stats.empty, (x1 - x0) * (y1 - y0));  // and where the scene has no surface
     const HoleScore s = Score(map, f.scene.depths[0], x0, y0, x1, y1);
     EXPECT_EQ(s.filled, stats.filled);
@@ -109,7 +110,7 @@ TEST(PlanarPriorTest, FillsAHoleWithTheTrueDepth) {
   {
     const int x0 = 40, y0 = 30, x1 = 120, y1 = 90;
     DepthNormalMap map = TrueMapWithHole(f, x0, y0, x1, y1);
-    FillFromPlanarPriors(f.views, 0, f.sources, f.source_depths, {}, nullptr,
+    FillFromPlanarPriors(f.views, {0, f.sources, f.source_depths, {}, nullptr},
                          PlanarPriorOptions(), &map);
     const HoleScore s = Score(map, f.scene.depths[0], x0, y0, x1, y1);
     EXPECT_GT(s.filled, 0);
@@ -130,7 +131,7 @@ TEST(PlanarPriorTest, SfmPointsAloneSupportAPlane) {
   ASSERT_GT(points.size(), 100u);
   PlanarPriorOptions options;
   const PlanarPriorStats stats = FillFromPlanarPriors(
-      f.views, 0, f.sources, f.source_depths, points, nullptr, options, &map);
+      f.views, {0, f.sources, f.source_depths, points, nullptr}, options, &map);
   const HoleScore s = Score(map, f.scene.depths[0], 0, 0, 160, 120);
   EXPECT_GT(stats.filled, 0);
   EXPECT_GE(s.filled, s.hole / 3);
@@ -144,7 +145,7 @@ TEST(PlanarPriorTest, SourcesVetoAPlaneInFrontOfWhatTheySee) {
   // Supports pulled 20 % towards the camera: every source saw the surface behind them.
   for (float& d : map.depth.data) d *= 0.8f;
   const PlanarPriorStats stats = FillFromPlanarPriors(
-      f.views, 0, f.sources, f.source_depths, {}, nullptr, PlanarPriorOptions(), &map);
+      f.views, {0, f.sources, f.source_depths, {}, nullptr}, PlanarPriorOptions(), &map);
   EXPECT_GT(stats.candidates, 0);
   EXPECT_EQ(stats.filled, 0);
 }
@@ -160,15 +161,15 @@ TEST(PlanarPriorTest, KeepsAPhotometricDepthOneSourceConfirms) {
     std::fill(v.grey.data.begin(), v.grey.data.end(), 1.f);
   }
   DepthNormalMap without = TrueMapWithHole(f, x0, y0, x1, y1);
-  EXPECT_EQ(FillFromPlanarPriors(f.views, 0, f.sources, f.source_depths, {}, nullptr,
+  EXPECT_EQ(FillFromPlanarPriors(f.views, {0, f.sources, f.source_depths, {}, nullptr},
                                  PlanarPriorOptions(), &without)
                 .filled,
             0);
   // The reference's photometric depth there (the truth, as the filter removed it).
   DepthNormalMap with = TrueMapWithHole(f, x0, y0, x1, y1);
-  const PlanarPriorStats stats =
-      FillFromPlanarPriors(f.views, 0, f.sources, f.source_depths, {}, &f.scene.depths[0],
-                           PlanarPriorOptions(), &with);
+  const PlanarPriorStats stats = FillFromPlanarPriors(
+      f.views, {0, f.sources, f.source_depths, {}, &f.scene.depths[0]},
+      PlanarPriorOptions(), &with);
   const HoleScore s = Score(with, f.scene.depths[0], x0, y0, x1, y1);
   EXPECT_GT(stats.filled, 0);
   EXPECT_EQ(s.within_1, s.filled);
@@ -179,7 +180,7 @@ TEST(PlanarPriorTest, DegenerateInputFillsNothingAndStaysFinite) {
   PlanarPriorOptions options;
   // No supports at all.
   DepthNormalMap empty = TrueMapWithHole(f, 0, 0, 160, 120);
-  EXPECT_EQ(FillFromPlanarPriors(f.views, 0, f.sources, f.source_depths, {}, nullptr,
+  EXPECT_EQ(FillFromPlanarPriors(f.views, {0, f.sources, f.source_depths, {}, nullptr},
                                  options, &empty)
                 .filled,
             0);
@@ -187,7 +188,7 @@ TEST(PlanarPriorTest, DegenerateInputFillsNothingAndStaysFinite) {
   DepthNormalMap row = TrueMapWithHole(f, 0, 0, 160, 120);
   for (int x = 0; x < 160; ++x) row.depth.at(x, 60) = f.scene.depths[0].at(x, 60);
   const std::vector<Eigen::Vector3d> far = {{1e4, 0, 1e4}, {0, 1e4, 1e4}, {-1e4, 0, 1e4}};
-  FillFromPlanarPriors(f.views, 0, f.sources, f.source_depths, far, nullptr, options,
+  FillFromPlanarPriors(f.views, {0, f.sources, f.source_depths, far, nullptr}, options,
                        &row);
   for (float d : row.depth.data) EXPECT_TRUE(std::isfinite(d));
   for (float n : row.normal.data) EXPECT_TRUE(std::isfinite(n));
@@ -197,7 +198,7 @@ TEST(PlanarPriorTest, DegenerateInputFillsNothingAndStaysFinite) {
   const Image none(160, 120, 1);
   const std::vector<const Image*> no_depths(f.sources.size(), &none);
   DepthNormalMap black = TrueMapWithHole(f, 40, 30, 120, 90);
-  FillFromPlanarPriors(f.views, 0, f.sources, no_depths, far, nullptr, options, &black);
+  FillFromPlanarPriors(f.views, {0, f.sources, no_depths, far, nullptr}, options, &black);
   for (float d : black.depth.data) EXPECT_TRUE(std::isfinite(d));
   for (float n : black.normal.data) EXPECT_TRUE(std::isfinite(n));
 }
@@ -210,20 +211,20 @@ TEST(PlanarPriorTest, BadOptionsAndSizesThrow) {
   EXPECT_THROW(bad.Check(), Error);
   bad = PlanarPriorOptions();
   bad.depth_tolerance = 0;
-  EXPECT_THROW(FillFromPlanarPriors(f.views, 0, f.sources, f.source_depths, {}, nullptr,
+  EXPECT_THROW(FillFromPlanarPriors(f.views, {0, f.sources, f.source_depths, {}, nullptr},
                                     bad, &map),
                Error);
   const std::vector<const Image*> one(1, f.source_depths[0]);
-  EXPECT_THROW(FillFromPlanarPriors(f.views, 0, f.sources, one, {}, nullptr,
+  EXPECT_THROW(FillFromPlanarPriors(f.views, {0, f.sources, one, {}, nullptr},
                                     PlanarPriorOptions(), &map),
                Error);
   PlanarPriorOptions off;
   off.enabled = false;
   EXPECT_EQ(off.ToString(), "planar_prior=0");
-  EXPECT_EQ(
-      FillFromPlanarPriors(f.views, 0, f.sources, f.source_depths, {}, nullptr, off, &map)
-          .filled,
-      0);
+  EXPECT_EQ(FillFromPlanarPriors(f.views, {0, f.sources, f.source_depths, {}, nullptr},
+                                 off, &map)
+                .filled,
+            0);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "colmap_ext/image_io.h"
 #include "fvs/path/video.h"
 #include "scene/scene_fixture.h"
+#include "scene/arc_workspace_test.h"
 #include "support/test_support.h"
 
 namespace fvs {
@@ -23,19 +24,13 @@ using testing::TempDir;
 
 namespace fs = std::filesystem;
 
-class VideoCommandTest : public ::testing::Test {
+class VideoCommandTest : public testing::ArcWorkspaceTest {
  protected:
-  void SetUp() override {
-    ws_ = dir_ / "ws";
-    testing::WriteTestWorkspace(ws_, testing::ArcViews(5, 64, 48),
-                                testing::MakeTestWorldMesh());
-  }
+  VideoCommandTest() : ArcWorkspaceTest(5, 64, 48) {}
   int Run(const std::string& args, std::string* output, const std::string& env = "") {
     return RunShell(env + " FVS_QUIET=1 " + FrontDoorBinary() + " " + args + " 2>&1",
                     output);
   }
-  TempDir dir_;
-  std::string ws_;
 };
 
 TEST_F(VideoCommandTest, PathThenVideoThenResume) {

@@ -13,6 +13,7 @@
 #include "colmap_ext/image_io.h"
 #include "colmap_ext/sparse_io.h"
 #include "scene/scene_fixture.h"
+#include "scene/arc_workspace_test.h"
 #include "support/test_support.h"
 
 namespace fvs {
@@ -27,14 +28,9 @@ using testing::WriteTextFile;
 
 namespace fs = std::filesystem;
 
-class ViewSynthesisCommandTest : public ::testing::Test {
+class ViewSynthesisCommandTest : public testing::ArcWorkspaceTest {
  protected:
-  void SetUp() override {
-    ws_ = dir_ / "ws";
-    views_ = ArcViews(7, 80, 60);
-    mesh_ = MakeTestWorldMesh();
-    testing::WriteTestWorkspace(ws_, views_, mesh_);
-  }
+  ViewSynthesisCommandTest() : ArcWorkspaceTest(7, 80, 60) {}
   int Run(const std::string& args, std::string* output) {
     return RunShell("FVS_QUIET=1 " + FrontDoorBinary() +
                         " view_synthesis --workspace_path " + ws_ + " " + args,
@@ -61,11 +57,6 @@ class ViewSynthesisCommandTest : public ::testing::Test {
   static int Lines(const std::string& s) {
     return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
   }
-
-  TempDir dir_;
-  std::string ws_;
-  std::vector<SceneView> views_;
-  TriangleMesh mesh_;
 };
 
 TEST_F(ViewSynthesisCommandTest, RendersHeldOutViewsWithExtras) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <random>
 
+#include "fvs/util/image_resize.h"
 #include "support/test_support.h"
 
 namespace fvs::testing {
@@ -24,27 +25,7 @@ Image Noise(int width, int height, unsigned seed) {
 
 // A box blur of radius r, `passes` times (about a Gaussian of sigma r sqrt(passes / 3)).
 Image Blur(Image image, int r, int passes) {
-  for (int p = 0; p < passes; ++p) {
-    Image out = image;
-    for (int y = 0; y < image.height; ++y) {
-      for (int x = 0; x < image.width; ++x) {
-        for (int c = 0; c < image.channels; ++c) {
-          float sum = 0;
-          int n = 0;
-          for (int dy = -r; dy <= r; ++dy) {
-            for (int dx = -r; dx <= r; ++dx) {
-              const int xx = x + dx, yy = y + dy;
-              if (xx < 0 || yy < 0 || xx >= image.width || yy >= image.height) continue;
-              sum += image.at(xx, yy, c);
-              ++n;
-            }
-          }
-          out.at(x, y, c) = sum / n;
-        }
-      }
-    }
-    image = out;
-  }
+  for (int p = 0; p < passes; ++p) image = BoxBlur(image, r);
   return image;
 }
 

@@ -7,6 +7,7 @@
 
 #include "fvs/util/error.h"
 #include "scene/scene_fixture.h"
+#include "geometry/geometry_test_util.h"
 
 namespace fvs {
 namespace {
@@ -58,12 +59,7 @@ TEST(SourceSelectionTest, NeverReturnsSourcesThatSeeNothingEvenForLargeK) {
 }
 
 TEST(SourceSelectionTest, DepthToleranceDecidesWhatCounts) {
-  PinholeCamera cam;
-  cam.width = 20;
-  cam.height = 10;
-  cam.fx = cam.fy = 20;
-  cam.cx = 10;
-  cam.cy = 5;
+  PinholeCamera cam = testing::CenteredCamera(20, 10, 20);
   const Image target_depth(20, 10, 1, 4.f);
   const Image source_depth(20, 10, 1, 4.f * 1.05f);  // 5% behind what the target sees
   EXPECT_EQ(CountVisibleTargetPixels(cam, target_depth, cam, source_depth, 0.10), 200);

@@ -41,16 +41,9 @@ class PrecisionTest : public ::testing::Test {
   static void TearDownTestSuite() { delete dir_; }
 
   static TrainOptions Options(const std::string& output) {
-    TrainOptions o;
-    o.scene_list = dir_->path() + "/train.txt";
-    o.output_path = dir_->path() + "/" + output;
-    o.model_config_json = kTinyNet;
-    o.num_sources = 2;
-    o.crop = 32;
+    TrainOptions o =
+        testing::TinyTrainOptions(dir_->path() + "/train.txt", dir_->path() + "/" + output);
     o.max_steps = 2;
-    o.quiet = true;
-    o.num_threads = 1;
-    o.device = "cpu";
     return o;
   }
   static TempDir* dir_;

@@ -51,19 +51,10 @@ class TrainerTest : public ::testing::Test {
   static void TearDownTestSuite() { delete dir_; }
 
   static TrainOptions Options(const std::string& output) {
-    TrainOptions o;
-    o.scene_list = dir_->path() + "/train.txt";
-    o.output_path = dir_->path() + "/" + output;
-    o.model_config_json = kTinyNet;
-    o.num_sources = 2;
-    o.crop = 32;
+    TrainOptions o =
+        testing::TinyTrainOptions(dir_->path() + "/train.txt", dir_->path() + "/" + output);
     o.max_steps = 4;
     o.log_every = 2;
-    o.quiet = true;
-    // One thread: on a loaded 2-core machine OpenMP's spinning threads cost more than
-    // they give at these sizes (and the resume test needs the same count in every run
-    // anyway).
-    o.num_threads = 1;
     return o;
   }
   static TempDir* dir_;

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "ui/workspace_contents.h"
+#include "geometry/geometry_test_util.h"
 
 namespace fvs::ui {
 namespace {
@@ -64,12 +65,7 @@ TEST(ViewerCamera, OrbitKeepsFocusAndZoomApproaches) {
 }
 
 TEST(ViewerCamera, LookThroughTakesPoseAndFieldOfView) {
-  PinholeCamera source;
-  source.width = 200;
-  source.height = 100;
-  source.fx = source.fy = 150;
-  source.cx = 100;
-  source.cy = 50;
+  PinholeCamera source = testing::CenteredCamera(200, 100, 150);
   source.R =
       Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   source.t = {0.3, -0.2, 2.0};

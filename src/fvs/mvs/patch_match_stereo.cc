@@ -298,8 +298,10 @@ PatchMatchStereoSummary RunPatchMatchStereo(const std::string& workspace_path,
             PatchMatchView(set.views, set.index_of.at(p.ref_image_id), sources_of(p),
                            options.patch_match, &source_depths, &init);
         const PlanarPriorStats prior = FillFromPlanarPriors(
-            set.views, set.index_of.at(p.ref_image_id), sources_of(p), source_depths,
-            ObservedPoints(rec, p.ref_image_id), &init.depth, options.planar_prior, &map);
+            set.views,
+            {set.index_of.at(p.ref_image_id), sources_of(p), source_depths,
+             ObservedPoints(rec, p.ref_image_id), &init.depth},
+            options.planar_prior, &map);
         summary.planar_prior.empty += prior.empty;
         summary.planar_prior.candidates += prior.candidates;
         summary.planar_prior.filled += prior.filled;

@@ -307,13 +307,15 @@ std::string PlanarPriorOptions::ToString() const {
   return s.str();
 }
 
-PlanarPriorStats FillFromPlanarPriors(const std::vector<StereoView>& views, int ref,
-                                      const std::vector<int>& sources,
-                                      const std::vector<const Image*>& source_depths,
-                                      const std::vector<Eigen::Vector3d>& sparse_points,
-                                      const Image* photometric,
+PlanarPriorStats FillFromPlanarPriors(const std::vector<StereoView>& views,
+                                      const PlanarPriorInputs& in,
                                       const PlanarPriorOptions& options,
                                       DepthNormalMap* map) {
+  const int ref = in.ref;
+  const std::vector<int>& sources = in.sources;
+  const std::vector<const Image*>& source_depths = in.source_depths;
+  const std::vector<Eigen::Vector3d>& sparse_points = in.sparse_points;
+  const Image* photometric = in.photometric;
   options.Check();
   PlanarPriorStats stats;
   if (!options.enabled) return stats;

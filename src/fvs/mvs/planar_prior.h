@@ -54,18 +54,25 @@ struct PlanarPriorStats {
   int64_t filled = 0;      // of those, pixels the sources agreed on
 };
 
-// Fills the pixels of `map` (views[ref]'s result of the geometric pass) that have no
-// depth. `source_depths`: one depth map per source (the sources' photometric maps, at
-// their working resolution; empty pixels are 0). `sparse_points`: world points the
-// reference view observes (its SfM points). `photometric` (may be null): the reference's
-// photometric map; a photometric depth that the geometric filter removed but that agrees
-// with the plane is kept when one source confirms it (no second view needed). Never
-// writes a non-finite depth or normal.
-PlanarPriorStats FillFromPlanarPriors(const std::vector<StereoView>& views, int ref,
-                                      const std::vector<int>& sources,
-                                      const std::vector<const Image*>& source_depths,
-                                      const std::vector<Eigen::Vector3d>& sparse_points,
-                                      const Image* photometric,
+// What the prior of one view is made from.
+struct PlanarPriorInputs {
+  int ref = 0;               // the view whose map is filled (an index into the views)
+  std::vector<int> sources;  // its source views
+  // One depth map per source (the sources' photometric maps, at their working
+  // resolution; empty pixels are 0).
+  std::vector<const Image*> source_depths;
+  // World points the reference view observes (its SfM points).
+  std::vector<Eigen::Vector3d> sparse_points;
+  // The reference's photometric map, or null: a photometric depth that the geometric
+  // filter removed but that agrees with the plane is kept when one source confirms it
+  // (no second view needed).
+  const Image* photometric = nullptr;
+};
+
+// Fills the pixels of `map` (views[in.ref]'s result of the geometric pass) that have no
+// depth. Never writes a non-finite depth or normal.
+PlanarPriorStats FillFromPlanarPriors(const std::vector<StereoView>& views,
+                                      const PlanarPriorInputs& in,
                                       const PlanarPriorOptions& options,
                                       DepthNormalMap* map);
 

@@ -14,25 +14,19 @@ namespace fvs {
 
 namespace {
 
-class NearestMethod : public Method {
+class NearestMethod : public PixelBlendMethod {
  public:
-  explicit NearestMethod(const RenderOptions& options) : options_(options) {
-    options_.Check();
+  explicit NearestMethod(const RenderOptions& options) : PixelBlendMethod(options) {
     // Only the best source is used: warping the others would be wasted work.
     options_.num_sources = 1;
   }
   std::string name() const override { return "nearest"; }
 
-  RenderResult Render(const Scene& scene, const TargetView& target) override {
-    PreparedTarget prepared = PrepareTarget(scene, target, options_);
-    RenderResult result;
-    result.timings = prepared.timings;
-    result.sources = prepared.sources;
-    Timer timer;
+ private:
+  void Blend(const Scene& scene, const TargetView& target, const PreparedTarget& prepared,
+             RenderResult* out) const override {
+    RenderResult& result = *out;
     const int w = target.camera.width, h = target.camera.height;
-    result.color = Image(w, h, 3);
-    result.confidence = Image(w, h, 1);
-    result.coverage = Image(w, h, 1);
     if (!prepared.sources.empty()) {
       const Image& photo = scene.SourceImage(prepared.sources[0].view_index);
       const WarpMap& warp = prepared.warps[0];
@@ -55,14 +49,7 @@ class NearestMethod : public Method {
           },
           options_.num_threads);
     }
-    result.depth = std::move(prepared.depth);
-    result.infinity = AtInfinityMask(result.depth, result.coverage);
-    result.timings.blend_s = timer.Seconds();
-    return result;
   }
-
- private:
-  RenderOptions options_;
 };
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "fvs/render/prepare.h"
 
 #include <algorithm>
+#include <utility>
 
 #include "fvs/scene/scene.h"
 #include "fvs/util/error.h"
@@ -80,6 +81,27 @@ PreparedTarget PrepareTarget(const Scene& scene, const TargetView& target,
   }
   prepared.timings.warp_s = timer.Seconds();
   return prepared;
+}
+
+PixelBlendMethod::PixelBlendMethod(const RenderOptions& options) : options_(options) {
+  options_.Check();
+}
+
+RenderResult PixelBlendMethod::Render(const Scene& scene, const TargetView& target) {
+  PreparedTarget prepared = PrepareTarget(scene, target, options_);
+  Timer timer;
+  RenderResult result;
+  result.timings = prepared.timings;
+  result.sources = prepared.sources;
+  const int w = target.camera.width, h = target.camera.height;
+  result.color = Image(w, h, 3);
+  result.confidence = Image(w, h, 1);
+  result.coverage = Image(w, h, 1);
+  Blend(scene, target, prepared, &result);
+  result.depth = std::move(prepared.depth);
+  result.infinity = AtInfinityMask(result.depth, result.coverage);
+  result.timings.blend_s = timer.Seconds();
+  return result;
 }
 
 }  // namespace fvs

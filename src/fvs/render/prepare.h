@@ -5,8 +5,8 @@
 
 #include <vector>
 
-#include "fvs/render/method.h"
 #include "fvs/geometry/warp.h"
+#include "fvs/render/method.h"
 
 namespace fvs {
 
@@ -28,5 +28,23 @@ std::vector<SourceScore> ApplySourceHysteresis(std::vector<SourceScore> ranked,
 // chosen ones by view index.
 PreparedTarget PrepareTarget(const Scene& scene, const TargetView& target,
                              const RenderOptions& options);
+
+// A method that blends the warped sources pixel by pixel on the CPU (`nearest`, `ulr`):
+// Render is PrepareTarget, then Blend into a result of the target's size (black colour,
+// zero confidence and coverage before it), then the target depth, the infinity mask and
+// the blend's time added.
+class PixelBlendMethod : public Method {
+ public:
+  RenderResult Render(const Scene& scene, const TargetView& target) final;
+
+ protected:
+  // Checks the options (fvs::Error when invalid).
+  explicit PixelBlendMethod(const RenderOptions& options);
+  // Writes result->color, confidence and coverage where some source sees the pixel.
+  virtual void Blend(const Scene& scene, const TargetView& target,
+                     const PreparedTarget& prepared, RenderResult* result) const = 0;
+
+  RenderOptions options_;
+};
 
 }  // namespace fvs

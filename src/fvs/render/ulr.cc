@@ -15,19 +15,15 @@ namespace fvs {
 
 namespace {
 
-class UlrMethod : public Method {
+class UlrMethod : public PixelBlendMethod {
  public:
-  explicit UlrMethod(const RenderOptions& options) : options_(options) {
-    options_.Check();
-  }
+  explicit UlrMethod(const RenderOptions& options) : PixelBlendMethod(options) {}
   std::string name() const override { return "ulr"; }
 
-  RenderResult Render(const Scene& scene, const TargetView& target) override {
-    PreparedTarget prepared = PrepareTarget(scene, target, options_);
-    RenderResult result;
-    result.timings = prepared.timings;
-    result.sources = prepared.sources;
-    Timer timer;
+ private:
+  void Blend(const Scene& scene, const TargetView& target, const PreparedTarget& prepared,
+             RenderResult* out) const override {
+    RenderResult& result = *out;
     const PinholeCamera& cam = target.camera;
     const int w = cam.width, h = cam.height;
     const int n = static_cast<int>(prepared.sources.size());
@@ -40,9 +36,6 @@ class UlrMethod : public Method {
     UlrOptions settings;
     settings.resolution_weight = options_.ulr_resolution_weight;
     settings.num_blend = options_.ulr_num_blend;
-    result.color = Image(w, h, 3);
-    result.confidence = Image(w, h, 1);
-    result.coverage = Image(w, h, 1);
     ParallelFor(
         0, h,
         [&](int64_t y) {
@@ -76,14 +69,7 @@ class UlrMethod : public Method {
           }
         },
         options_.num_threads);
-    result.depth = std::move(prepared.depth);
-    result.infinity = AtInfinityMask(result.depth, result.coverage);
-    result.timings.blend_s = timer.Seconds();
-    return result;
   }
-
- private:
-  RenderOptions options_;
 };
 
 }  // namespace

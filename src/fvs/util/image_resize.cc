@@ -72,4 +72,27 @@ Image ResizeArea(const Image& image, int width, int height) {
   return out;
 }
 
+Image BoxBlur(const Image& image, int radius) {
+  Require(radius >= 0, "box blur", "negative radius");
+  Image out = image;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      for (int c = 0; c < image.channels; ++c) {
+        float sum = 0;
+        int n = 0;
+        for (int yy = std::max(0, y - radius); yy <= std::min(image.height - 1, y + radius);
+             ++yy) {
+          for (int xx = std::max(0, x - radius);
+               xx <= std::min(image.width - 1, x + radius); ++xx) {
+            sum += image.at(xx, yy, c);
+            ++n;
+          }
+        }
+        out.at(x, y, c) = sum / n;
+      }
+    }
+  }
+  return out;
+}
+
 }  // namespace fvs

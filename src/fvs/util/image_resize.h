@@ -1,4 +1,4 @@
-// Resampling of float images.
+// Resampling and box filtering of float images.
 #pragma once
 
 #include "fvs/util/image.h"
@@ -9,5 +9,11 @@ namespace fvs {
 // for the 4x reduction of training images and the small photos the backdrop fit
 // compares; also works for enlargements (nearest).
 Image ResizeArea(const Image& image, int width, int height);
+
+// The mean over the (2 radius + 1)^2 window around each pixel, of the window's pixels
+// inside the image (no padding counted), per channel; radius 0: the image. Three passes
+// approach a Gaussian of sigma radius (1 pass: radius sqrt(1/3)); blurred photos for the
+// photo-quality tests and benchmark.
+Image BoxBlur(const Image& image, int radius);
 
 }  // namespace fvs
