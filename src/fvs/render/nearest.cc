@@ -8,7 +8,6 @@
 #include "fvs/render/ulr.h"
 #include "fvs/scene/scene.h"
 #include "fvs/util/parallel.h"
-#include "fvs/util/progress.h"
 
 namespace fvs {
 

@@ -9,7 +9,6 @@
 #include "fvs/render/prepare.h"
 #include "fvs/scene/scene.h"
 #include "fvs/util/parallel.h"
-#include "fvs/util/progress.h"
 
 namespace fvs {
 

@@ -11,9 +11,9 @@ namespace fvs {
 Image ResizeArea(const Image& image, int width, int height);
 
 // The mean over the (2 radius + 1)^2 window around each pixel, of the window's pixels
-// inside the image (no padding counted), per channel; radius 0: the image. Three passes
-// approach a Gaussian of sigma radius (1 pass: radius sqrt(1/3)); blurred photos for the
-// photo-quality tests and benchmark.
+// inside the image (no padding counted), per channel; radius 0: the image. Each pass adds
+// a variance of radius (radius + 1) / 3 per axis, so a few passes approach a Gaussian
+// (three: sigma about radius); blurred photos for the photo-quality tests and benchmark.
 Image BoxBlur(const Image& image, int radius);
 
 }  // namespace fvs
