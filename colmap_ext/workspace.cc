@@ -8,10 +8,20 @@
 
 namespace fvs::colmap {
 
-std::string DenseWorkspace::ProxyMeshPath() const {
+std::string DenseWorkspace::PreparedMeshPath() const {
   std::error_code ec;
   const std::string refined = RefinedMeshPath();
   return std::filesystem::is_regular_file(refined, ec) ? refined : DelaunayMeshPath();
+}
+
+std::string DenseWorkspace::ProxyMeshPath() const {
+  namespace fs = std::filesystem;
+  std::error_code ec, ec2;
+  const std::string prepared = PreparedMeshPath(), scene = SceneRefinedMeshPath();
+  if (!fs::is_regular_file(scene, ec)) return prepared;
+  const auto scene_time = fs::last_write_time(scene, ec);
+  const auto prepared_time = fs::last_write_time(prepared, ec2);
+  return !ec && (ec2 || scene_time >= prepared_time) ? scene : prepared;
 }
 
 void CheckDenseWorkspace(const DenseWorkspace& workspace) {

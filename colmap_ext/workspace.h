@@ -33,8 +33,14 @@ struct DenseWorkspace {
   std::string DelaunayMeshPath() const { return root + "/meshed-delaunay.ply"; }
   // The Delaunay mesh refined by photo-consistency (prepare's mesh_refinement stage).
   std::string RefinedMeshPath() const { return root + "/meshed-refined.ply"; }
-  // The proxy mesh the renderers use: the refined mesh where prepare made one, else the
-  // Delaunay mesh.
+  // The mesh prepare leaves: the refined mesh where prepare made one, else the Delaunay
+  // mesh.
+  std::string PreparedMeshPath() const;
+  // That mesh refined per scene by the photo-consistency of its renders
+  // (view_synthesis_refine, train/scene_refine.h).
+  std::string SceneRefinedMeshPath() const { return root + "/fvs/refine/mesh.ply"; }
+  // The proxy mesh the renderers use: the scene-refined mesh where there is one no older
+  // than prepare's (a prepare that meshes again makes it stale), else prepare's mesh.
   std::string ProxyMeshPath() const;
   std::string PoissonMeshPath() const { return root + "/meshed-poisson.ply"; }
   std::string FvsDir() const { return root + "/fvs"; }

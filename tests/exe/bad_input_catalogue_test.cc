@@ -492,6 +492,12 @@ std::vector<BadInputCase> Catalogue() {
        "view_synthesis_depth_cache --workspace_path W",
        "W/meshed-delaunay.ply",
        {"truncated"}},
+      // view_synthesis_refine: the mesh is read before anything is written into W.
+      {"refine_mesh_truncated",
+       [](const std::string& d) { Truncate(d + "/W/meshed-delaunay.ply", 300); },
+       "view_synthesis_refine --workspace_path W --minutes 0.1",
+       "W/meshed-delaunay.ply",
+       {"truncated"}},
       {"depth_cache_disk_full",
        [](const std::string& d) { fs::remove_all(d + "/W/fvs/depth"); },
        "view_synthesis_depth_cache --workspace_path W",

@@ -111,7 +111,7 @@ void BuildBackdrop(const std::string& workspace_path, const BackdropOptions& opt
   BackdropFit fit;
   if (options.enabled) {
     const auto views = ReadGeometryPhotos<BackdropView>(ws);
-    const TriangleMesh mesh = ReadPlyMesh(ws.ProxyMeshPath());
+    const TriangleMesh mesh = ReadPlyMesh(ws.PreparedMeshPath());
     fit = FitBackdrop(views, mesh, options);
   }
   if (fit.mesh.faces.empty()) {

@@ -1,6 +1,8 @@
 #include "fvs/scene/scene.h"
 
+#include <cstdlib>
 #include <filesystem>
+#include <iostream>
 
 #include "colmap_ext/image_io.h"
 #include "colmap_ext/sparse_io.h"
@@ -133,6 +135,11 @@ Scene Scene::Load(const std::string& workspace_path, const SceneLoadOptions& opt
   const std::string mesh_path = workspace.ProxyMeshPath();
   Require(std::filesystem::is_regular_file(mesh_path), mesh_path,
           "no proxy mesh (run colmap view_synthesis_prepare or view_synthesis_mesher)");
+  const char* quiet = std::getenv("FVS_QUIET");  // as the progress lines
+  if (mesh_path == workspace.SceneRefinedMeshPath() && !(quiet && quiet[0] == '1')) {
+    std::cerr << "using the scene-refined mesh " << mesh_path
+              << " (view_synthesis_refine)\n";
+  }
 
   const colmap::Reconstruction reconstruction =
       colmap::ReadSparseModel(workspace.SparseDir());

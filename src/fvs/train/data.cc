@@ -63,6 +63,15 @@ PackedScene LoadPackedScene(const std::string& folder) {
   const int64_t n = static_cast<int64_t>(s.names.size());
   Require(n >= 1, path, "the scene has no views");
   s.holdout.assign(n, false);
+  if (auto origin = file.metadata.find("origin"); origin != file.metadata.end()) {
+    try {
+      const nlohmann::json o = nlohmann::json::parse(origin->second);
+      s.origin = {o.at(0).get<double>(), o.at(1).get<double>(), o.at(2).get<double>()};
+    } catch (const std::exception&) {
+      throw Error(path, "the 'origin' metadata is not a JSON list of three numbers");
+    }
+    Require(s.origin.allFinite(), path, "the 'origin' metadata is not finite");
+  }
   if (auto held = file.metadata.find("holdout"); held != file.metadata.end()) {
     try {
       for (const auto& h : nlohmann::json::parse(held->second)) {
@@ -145,10 +154,6 @@ torch::Tensor FillHolesOf(const torch::Tensor& rgb, const torch::Tensor& covered
   return ImageToTensor(color).to(rgb.device());
 }
 
-namespace {
-
-// A camera of the packed set (K [3,3], R [3,3], t [3], any floating type) as the warp's
-// PinholeCamera (fx, fy, cx, cy of K).
 PinholeCamera TensorCamera(const torch::Tensor& K, const torch::Tensor& R,
                            const torch::Tensor& t, int64_t width, int64_t height) {
   const torch::Tensor k = K.to(torch::kDouble).cpu().contiguous();
@@ -167,6 +172,8 @@ PinholeCamera TensorCamera(const torch::Tensor& K, const torch::Tensor& R,
   }
   return camera;
 }
+
+namespace {
 
 // A depth map [h, w] as a 1-channel Image.
 Image DepthImage(const torch::Tensor& depth) {

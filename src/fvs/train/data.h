@@ -28,12 +28,19 @@ struct PackedScene {
   // Views held out of the geometry at prepare (the pack's "holdout" metadata): never a
   // source; a target only where IsTargetView says so.
   std::vector<bool> holdout;
+  // World = scene frame + origin (the pack's "origin" metadata; zero when absent).
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   bool HoldsViewsOut() const;
 
   int num_views() const { return static_cast<int>(names.size()); }
   int height() const { return static_cast<int>(images.size(2)); }
   int width() const { return static_cast<int>(images.size(3)); }
 };
+
+// A camera of the packed set (K [3,3], R [3,3], t [3], any floating type) as the warp's
+// PinholeCamera (fx, fy, cx, cy of K) for an image of width x height.
+PinholeCamera TensorCamera(const torch::Tensor& K, const torch::Tensor& R,
+                           const torch::Tensor& t, int64_t width, int64_t height);
 
 // Reads folder/scene.safetensors and checks every tensor (dtypes, shapes, finite values,
 // depths >= 0, overlap in [0,1]); throws fvs::Error naming the file.
