@@ -25,7 +25,7 @@ struct MeshPhotoRefineOptions {
   double seconds = 600;         // wall-time budget of the optimisation (> 0)
   int num_sources = 4;          // sources per leave-one-out target
   int pixels_per_step = 65536;  // sampled over all targets' surface pixels
-  double step = 0.02;           // Adam step size, in median edge lengths
+  double step = 0.01;           // Adam step size, in median edge lengths
   double smoothness = 0.05;     // weight of the Laplacian term (see the .cc)
   double max_move = 2.0;        // displacement bound, in median edge lengths
   int steps_per_raster = 40;    // re-rasterise (faces, visibility, weights) this often
