@@ -211,10 +211,17 @@ torch::Tensor Render(const FrozenPixels& f, const torch::Tensor& pick,
   return colour;
 }
 
+// Per pixel: sqrt(|render - truth|^2 + eps^2) - eps, [M].
+torch::Tensor CharbonnierPerPixel(const torch::Tensor& render, const torch::Tensor& truth,
+                                  double eps) {
+  return ((render - truth).pow(2).sum(1) + eps * eps).sqrt() - eps;
+}
+
+// Its mean over the usable pixels.
 torch::Tensor Charbonnier(const torch::Tensor& render, const torch::Tensor& truth,
                           const torch::Tensor& usable, double eps) {
-  const torch::Tensor e = ((render - truth).pow(2).sum(1) + eps * eps).sqrt() - eps;
-  return (e * usable).sum() / usable.sum().clamp_min(1);
+  return (CharbonnierPerPixel(render, truth, eps) * usable).sum() /
+         usable.sum().clamp_min(1);
 }
 
 // Mean Charbonnier error over all frozen pixels, in chunks, without gradients.
@@ -228,8 +235,7 @@ double FullError(const FrozenPixels& f, const torch::Tensor& vertices,
     const torch::Tensor pick = torch::arange(i, std::min(n, i + chunk), torch::kLong);
     torch::Tensor usable;
     const torch::Tensor r = Render(f, pick, vertices, faces, c, photos, &usable);
-    const torch::Tensor e =
-        ((r - f.rgb.index_select(0, pick)).pow(2).sum(1) + eps * eps).sqrt() - eps;
+    const torch::Tensor e = CharbonnierPerPixel(r, f.rgb.index_select(0, pick), eps);
     sum += (e * usable).sum().item<double>();
     count += usable.sum().item<double>();
   }
@@ -390,7 +396,8 @@ MeshPhotoRefineResult RefineMeshByPhotoConsistency(
   FrozenPixels frozen = Freeze(scene, Moved(mesh, offsets()), targets, sharp, o);
   result.initial_error = FullError(frozen, base + offsets().detach(), faces, cameras,
                                    sharp, o.charbonnier_eps);
-  frozen = Freeze(scene, Moved(mesh, offsets()), targets, photos, o);
+  // The first level's colours (the sharp ones are frozen already without blurred levels).
+  if (level > 0) frozen = Freeze(scene, Moved(mesh, offsets()), targets, photos, o);
   // The final error and the last rasterisation take about what the first did.
   const double reserve = 2 * timer.Seconds();
   const double start = timer.Seconds();

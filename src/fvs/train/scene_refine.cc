@@ -143,12 +143,15 @@ SceneRefineSummary RunSceneRefine(const SceneRefineOptions& o) {
   }
   SceneRefineSummary summary;
   summary.mesh_path = result_path.string();
-  if (state.minutes_done >= o.minutes && fs::is_regular_file(result_path)) {
+  // Nothing (more) to do: the result as it stands.
+  auto as_done = [&] {
     summary.already_done = true;
     summary.steps = state.steps;
     summary.seconds = state.seconds;
     return summary;
-  }
+  };
+  if (state.minutes_done >= o.minutes && fs::is_regular_file(result_path))
+    return as_done();
   if (!fs::is_regular_file(root / "pack" / kPackedSceneFile) ||
       state.pack_scale != o.pack_scale) {
     if (!o.quiet)
@@ -181,8 +184,7 @@ SceneRefineSummary RunSceneRefine(const SceneRefineOptions& o) {
     Require(fs::is_regular_file(result_path), kSubject,
             "the budget of --minutes " + std::to_string(o.minutes) +
                 " is spent before refining: give more minutes");
-    summary.already_done = true;
-    return summary;
+    return as_done();
   }
   refine.checkpoint = [&](const TriangleMesh& mesh, int steps) {
     WriteMesh(root / "checkpoint.ply", Shifted(mesh, scene.origin));
