@@ -9,6 +9,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QMenuBar>
+#include <QMetaObject>
 #include <QProgressBar>
 #include <QPushButton>
 #include <QSpinBox>
@@ -26,6 +27,7 @@
 #include "fvs/scene/scene.h"
 #include "fvs/util/error.h"
 #include "fvs/util/folder_lock.h"
+#include "ui/live_view.h"
 #include "ui/path_panel.h"
 #include "ui/result_panel.h"
 #include "ui/scene_view.h"
@@ -93,6 +95,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   layout->addWidget(main_split, 1);
   setCentralWidget(central);
   BuildMenus();
+  scene_view_->SetLiveEnabled(live_action_->isChecked());
 
   connect(runner_, &TaskRunner::progress, this,
           [this](int done, int total, const QString& text) {
@@ -101,14 +104,19 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
             if (total > 0) progress_->setValue(done);
             progress_label_->setText(text);
           });
-  connect(runner_, &TaskRunner::started, this, [this] { UpdateEnabled(); });
+  connect(runner_, &TaskRunner::started, this, [this] {
+    if (live_) live_->Pause();  // the task gets the cores
+    UpdateEnabled();
+  });
   connect(runner_, &TaskRunner::stopped, this, [this](bool cancelled) {
     progress_->setRange(0, 1);
     progress_->setValue(0);
     progress_->setTextVisible(false);
     progress_label_->setText(cancelled ? "Cancelled" : "");
     UpdateEnabled();
+    RequestLiveFrame();
   });
+  connect(scene_view_, &SceneView::viewChanged, this, [this] { RequestLiveFrame(); });
   connect(scene_view_, &SceneView::cameraClicked, this, [this](int index) {
     if (!contents_) return;
     statusBar()->showMessage("Looking through " +
@@ -119,7 +127,8 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent) {
   statusBar()->showMessage("File > Open workspace to start");
 }
 
-MainWindow::~MainWindow() = default;
+// The live renderer's thread joins before the widgets go.
+MainWindow::~MainWindow() { live_.reset(); }
 
 void MainWindow::BuildMenus() {
   QMenu* file = menuBar()->addMenu("&File");
@@ -151,6 +160,15 @@ void MainWindow::BuildMenus() {
   reset->setObjectName("action_reset_view");
   QAction* overview = view->addAction("&Overview", scene_view_, &SceneView::ShowOverview);
   overview->setObjectName("action_overview");
+  view->addSeparator();
+  live_action_ = view->addAction("&Live novel view");
+  live_action_->setObjectName("action_live_view");
+  live_action_->setCheckable(true);
+  live_action_->setChecked(true);
+  live_action_->setToolTip(
+      "Show the view rendered from the photos while the camera moves (reduced "
+      "resolution), sharpening to full size when it stops");
+  connect(live_action_, &QAction::toggled, this, [this](bool on) { SetLiveView(on); });
 
   QMenu* render = menuBar()->addMenu("&Render");
   render_action_ =
@@ -206,6 +224,8 @@ QWidget* MainWindow::BuildControls() {
   num_sources_->setRange(0, 16);
   num_sources_->setSpecialValueText("auto");  // 0: adaptive K (RenderOptions)
   num_sources_->setValue(0);                  // auto
+  connect(num_sources_, qOverload<int>(&QSpinBox::valueChanged), this,
+          [this] { RequestLiveFrame(); });
   form->addRow("Sources (K)", num_sources_);
   auto* size_row = new QHBoxLayout();
   width_ = new QSpinBox(render_box);
@@ -318,6 +338,7 @@ QString MainWindow::OpenWorkspace(const QString& path) {
 void MainWindow::ShowContents(std::shared_ptr<const WorkspaceContents> contents) {
   contents_ = std::move(contents);
   last_render_.reset();
+  ResetLiveRenderer();
   scene_view_->SetContents(contents_);
   path_panel_->SetContents(contents_);
   result_panel_->Show(nullptr, nullptr);
@@ -360,6 +381,7 @@ void MainWindow::ShowContents(std::shared_ptr<const WorkspaceContents> contents)
               QString::fromStdString(contents_->render_error) + notes);
   }
   UpdateEnabled();
+  RequestLiveFrame();
 }
 
 void MainWindow::SetInitialSettings(const QString& method, const QString& model_path) {
@@ -458,6 +480,98 @@ void MainWindow::CancelTask() {
 void MainWindow::OnMethodChanged() {
   const bool needs = MethodNeedsWeights(method_->currentText().toStdString());
   model_path_->setEnabled(needs);
+  RequestLiveFrame();
+}
+
+void MainWindow::SetLiveView(bool on) {
+  if (live_action_->isChecked() != on)
+    return live_action_->setChecked(on);  // toggles back
+  scene_view_->SetLiveEnabled(on);
+  if (!on && live_) live_->Pause();
+  if (on) RequestLiveFrame();
+}
+
+bool MainWindow::live_view() const { return live_action_ && live_action_->isChecked(); }
+
+double MainWindow::live_fps() const {
+  const double now = SteadySeconds();
+  int n = 0;
+  for (double t : live_arrivals_) n += now - t <= 1.0;
+  return n;
+}
+
+void MainWindow::ResetLiveRenderer() {
+  live_.reset();  // joins its thread; what it posted is dropped by the epoch
+  ++live_epoch_;
+  live_frame_.reset();
+  live_arrivals_.clear();
+  if (!contents_ || !contents_->can_render()) return;
+  const uint64_t epoch = live_epoch_;
+  live_ = std::make_unique<LiveRenderer>(
+      contents_->scene, LiveViewOptions(),
+      [this, epoch](std::shared_ptr<const LiveFrame> frame) {
+        QMetaObject::invokeMethod(
+            this,
+            [this, epoch, frame] {
+              if (epoch == live_epoch_) ShowLiveFrame(frame);
+            },
+            Qt::QueuedConnection);
+      },
+      [this, epoch](const std::string& error) {
+        const QString text = QString::fromStdString(error);
+        QMetaObject::invokeMethod(
+            this,
+            [this, epoch, text] {
+              if (epoch == live_epoch_) ShowError("Live view: " + text);
+            },
+            Qt::QueuedConnection);
+      });
+}
+
+void MainWindow::RequestLiveFrame() {
+  if (!live_ || !live_view() || runner_->busy()) return;
+  NovelViewOptions request = CurrentRequest();
+  // The live frames need no weights; the complete frame falls back to ulr when the
+  // chosen method cannot render (Render says why).
+  if (!CannotRenderReason(request).isEmpty()) {
+    request = NovelViewOptions();
+    request.method = "ulr";
+  }
+  live_->Request(scene_view_->ViewCamera(), request);
+}
+
+void MainWindow::ShowLiveFrame(std::shared_ptr<const LiveFrame> frame) {
+  live_frame_ = frame;
+  const RenderedView& view = frame->view;
+  const Image& color = view.result.color;
+  QImage image(color.width, color.height, QImage::Format_RGB888);
+  for (int y = 0; y < color.height; ++y) {
+    uchar* row = image.scanLine(y);
+    for (int i = 0; i < 3 * color.width; ++i) {
+      const float v = color.data[static_cast<size_t>(y) * 3 * color.width + i];
+      row[i] = static_cast<uchar>(std::lround(std::clamp(v, 0.f, 1.f) * 255.f));
+    }
+  }
+  const QString size = QString("%1x%2").arg(color.width).arg(color.height);
+  const QString method = QString::fromStdString(view.method);
+  QString caption;
+  if (frame->level == 0 && !frame->complete()) {
+    live_arrivals_.push_back(SteadySeconds());
+    while (live_arrivals_.size() > 64) live_arrivals_.pop_front();
+    caption =
+        QString("Live: %1 at %2, %3 fps").arg(method, size).arg(live_fps(), 0, 'f', 0);
+  } else if (!frame->complete()) {
+    caption = QString("Sharpening %1/%2: %3 at %4")
+                  .arg(frame->level + 1)
+                  .arg(frame->num_levels)
+                  .arg(method, size);
+  } else {
+    caption = QString("%1 at %2, K %3, %4 s")
+                  .arg(method, size)
+                  .arg(view.num_sources > 0 ? QString::number(view.num_sources) : "auto")
+                  .arg(view.seconds, 0, 'f', 2);
+  }
+  scene_view_->SetLiveImage(std::move(image), caption);
 }
 
 void MainWindow::UpdateEnabled() {

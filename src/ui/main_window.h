@@ -9,6 +9,7 @@
 
 #include <QMainWindow>
 #include <QString>
+#include <deque>
 #include <functional>
 #include <memory>
 
@@ -25,6 +26,8 @@ class QSpinBox;
 
 namespace fvs::ui {
 
+class LiveRenderer;
+struct LiveFrame;
 class PathPanel;
 class ResultPanel;
 class SceneView;
@@ -48,6 +51,17 @@ class MainWindow : public QMainWindow {
   // Renders the current viewpoint with the chosen settings (the Render button / menu).
   void RenderCurrentView();
   void CancelTask();
+
+  // The live view (View > Live novel view, on by default): while the camera moves the 3D
+  // view shows the novel view at a resolution that holds the frame rate, sharpening to
+  // the full size with the chosen method and K when it stops (ui/live_view.h). Paused
+  // while another task runs.
+  void SetLiveView(bool on);
+  bool live_view() const;
+  // The last live frame shown (null when none), and the frame rate of the live frames of
+  // the last second.
+  const std::shared_ptr<const LiveFrame>& live_frame() const { return live_frame_; }
+  double live_fps() const;
 
   // Method and weights to start with (command-line options); an unknown method is
   // reported in the message bar.
@@ -85,6 +99,9 @@ class MainWindow : public QMainWindow {
   void ShowContents(std::shared_ptr<const WorkspaceContents> contents);
   void UpdateEnabled();
   void OnMethodChanged();
+  void RequestLiveFrame();
+  void ShowLiveFrame(std::shared_ptr<const LiveFrame> frame);
+  void ResetLiveRenderer();
 
   std::shared_ptr<const WorkspaceContents> contents_;
   std::shared_ptr<const RenderedView> last_render_;
@@ -108,6 +125,13 @@ class MainWindow : public QMainWindow {
   ResultPanel* result_panel_ = nullptr;
   QAction* render_action_ = nullptr;
   QAction* cancel_action_ = nullptr;
+  QAction* live_action_ = nullptr;
+
+  std::unique_ptr<LiveRenderer> live_;
+  uint64_t live_epoch_ = 0;  // frames posted by an earlier renderer are dropped
+  std::shared_ptr<const LiveFrame> live_frame_;
+  std::deque<double>
+      live_arrivals_;  // steady seconds of the live frames of the last second
 };
 
 // Sets the OpenGL format every window of the application uses (3.3 core, depth buffer).

@@ -14,6 +14,7 @@ namespace fvs::ui {
 struct NovelViewOptions {
   std::string method = "ulr";
   int num_sources = 0;  // 0 = auto (RenderOptions::num_sources)
+  int max_num_sources = RenderOptions().max_num_sources;  // of auto
   int width = 640;
   int height = 480;
   std::string model_path;  // weights, for the fvs methods

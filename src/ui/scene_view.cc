@@ -2,6 +2,7 @@
 
 #include <QKeyEvent>
 #include <QMouseEvent>
+#include <QPainter>
 #include <QWheelEvent>
 #include <algorithm>
 #include <cmath>
@@ -111,6 +112,8 @@ void SceneView::SetContents(std::shared_ptr<const WorkspaceContents> contents) {
   highlighted_.clear();
   keyframes_.clear();
   path_preview_.clear();
+  live_image_ = QImage();
+  live_caption_.clear();
   scene_dirty_ = overlays_dirty_ = true;
   ResetView();
 }
@@ -311,9 +314,49 @@ void SceneView::Draw(QOpenGLShaderProgram* program, Batch* batch, unsigned int m
   program->release();
 }
 
+void SceneView::SetLiveEnabled(bool on) {
+  live_enabled_ = on;
+  update();
+}
+
+void SceneView::SetLiveImage(QImage image, const QString& caption) {
+  live_image_ = std::move(image);
+  live_caption_ = caption;
+  update();
+}
+
+void SceneView::ClearLiveImage() {
+  live_image_ = QImage();
+  live_caption_.clear();
+  update();
+}
+
+void SceneView::PaintLiveImage() {
+  // The frame has the widget's aspect (it is rendered for ViewCamera()); a live frame is
+  // smaller and is scaled up bilinearly.
+  QPainter painter(this);
+  painter.setRenderHint(QPainter::SmoothPixmapTransform);
+  painter.drawImage(rect(), live_image_);
+  if (live_caption_.isEmpty()) return;
+  const QRect box = painter.fontMetrics()
+                        .boundingRect(rect().adjusted(8, 8, -8, -8),
+                                      Qt::AlignLeft | Qt::AlignTop, live_caption_)
+                        .adjusted(-5, -3, 5, 3);
+  painter.fillRect(box, QColor(0, 0, 0, 150));
+  painter.setPen(QColor(235, 235, 235));
+  painter.drawText(box, Qt::AlignCenter, live_caption_);
+}
+
 void SceneView::paintGL() {
   glClearColor(0.16f, 0.17f, 0.19f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (showing_live_image()) return PaintLiveImage();
+  // QPainter (the live image) leaves its own state behind.
+  glEnable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glDisable(GL_SCISSOR_TEST);
+  const qreal ratio = devicePixelRatioF();
+  glViewport(0, 0, static_cast<int>(width() * ratio), static_cast<int>(height() * ratio));
   if (!gl_ready_ || !flat_program_->isLinked() || !mesh_program_->isLinked()) return;
   if (scene_dirty_) UploadScene();
   if (overlays_dirty_) UploadOverlays();

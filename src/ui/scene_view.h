@@ -6,12 +6,14 @@
 // frusta/lines.
 #pragma once
 
+#include <QImage>
 #include <QOpenGLBuffer>
 #include <QOpenGLExtraFunctions>
 #include <QOpenGLShaderProgram>
 #include <QOpenGLVertexArrayObject>
 #include <QOpenGLWidget>
 #include <QPoint>
+#include <QString>
 #include <memory>
 #include <vector>
 
@@ -43,6 +45,16 @@ class SceneView : public QOpenGLWidget, protected QOpenGLExtraFunctions {
   // frame.
   void SetKeyframes(std::vector<PinholeCamera> cameras);
   void SetPathPreview(std::vector<Eigen::Vector3d> centers);
+
+  // The live novel view (ui/live_view.h, driven by the window): while on and a frame has
+  // arrived, the view shows that frame (scaled to the widget) with its caption instead
+  // of the points, cameras and mesh.
+  void SetLiveEnabled(bool on);
+  bool live_enabled() const { return live_enabled_; }
+  void SetLiveImage(QImage image, const QString& caption);
+  void ClearLiveImage();
+  bool showing_live_image() const { return live_enabled_ && !live_image_.isNull(); }
+  const QString& live_caption() const { return live_caption_; }
 
   ViewerCamera& camera() { return camera_; }
   const ViewerCamera& camera() const { return camera_; }
@@ -76,6 +88,7 @@ class SceneView : public QOpenGLWidget, protected QOpenGLExtraFunctions {
   void UploadOverlays();
   void Draw(QOpenGLShaderProgram* program, Batch* batch, unsigned int mode,
             const Eigen::Matrix4d& mvp, bool indexed);
+  void PaintLiveImage();
 
   std::shared_ptr<const WorkspaceContents> contents_;
   ViewerCamera camera_;
@@ -83,6 +96,9 @@ class SceneView : public QOpenGLWidget, protected QOpenGLExtraFunctions {
   std::vector<int> highlighted_;
   std::vector<PinholeCamera> keyframes_;
   std::vector<Eigen::Vector3d> path_preview_;
+  bool live_enabled_ = false;
+  QImage live_image_;
+  QString live_caption_;
 
   bool gl_ready_ = false, scene_dirty_ = true, overlays_dirty_ = true;
   std::unique_ptr<QOpenGLShaderProgram> flat_program_, mesh_program_;

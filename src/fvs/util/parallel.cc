@@ -7,6 +7,8 @@
 #include <thread>
 #include <vector>
 
+#include "fvs/util/cancel.h"
+
 namespace fvs {
 
 int DefaultNumThreads() {
@@ -22,6 +24,10 @@ void ParallelForRanges(int64_t begin, int64_t end,
                        const std::function<void(int64_t, int64_t, int)>& fn,
                        int num_threads) {
   if (end <= begin) return;
+  // A cancellable caller (util/cancel.h) hands its flag to the threads started here, so
+  // that the ParallelFor calls nested in fn see it too.
+  const std::atomic<bool>* cancel = CurrentCancelFlag();
+  ThrowIfCancelled(cancel);
   if (num_threads <= 0) num_threads = DefaultNumThreads();
   const int64_t n = end - begin;
   const int threads = static_cast<int>(std::min<int64_t>(num_threads, n));
@@ -32,6 +38,7 @@ void ParallelForRanges(int64_t begin, int64_t end,
   std::exception_ptr first_error;
   std::mutex mutex;
   auto run = [&](int t) {
+    const CancelScope scope(cancel);
     try {
       fn(begin + n * t / threads, begin + n * (t + 1) / threads, t);
     } catch (...) {
@@ -47,6 +54,7 @@ void ParallelForRanges(int64_t begin, int64_t end,
   run(0);
   for (auto& w : workers) w.join();
   if (first_error) std::rethrow_exception(first_error);
+  ThrowIfCancelled(cancel);
 }
 
 void ParallelFor(int64_t begin, int64_t end, const std::function<void(int64_t)>& fn,
@@ -54,7 +62,11 @@ void ParallelFor(int64_t begin, int64_t end, const std::function<void(int64_t)>&
   ParallelForRanges(
       begin, end,
       [&fn](int64_t b, int64_t e, int) {
-        for (int64_t i = b; i < e; ++i) fn(i);
+        const std::atomic<bool>* cancel = CurrentCancelFlag();
+        for (int64_t i = b; i < e; ++i) {
+          ThrowIfCancelled(cancel);
+          fn(i);
+        }
       },
       num_threads);
 }
