@@ -14,6 +14,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QListWidget>
+#include <QMouseEvent>
 #include <QProgressBar>
 #include <QPushButton>
 #include <QRadioButton>
@@ -31,6 +32,7 @@
 #include "fvs/util/folder_lock.h"
 #include "support/test_support.h"
 #include "ui/image_view.h"
+#include "ui/live_view.h"
 #include "ui/path_panel.h"
 #include "ui/scene_view.h"
 
@@ -110,6 +112,9 @@ class MainWindowTest : public ::testing::Test {
       const QString answer = answers_[static_cast<int>(role)];
       return answer;
     });
+    // The tests of the 3D view's drawing and of Render see the scene itself; the live
+    // view (on by default) has tests of its own below.
+    window_->SetLiveView(false);
     window_->show();
     ASSERT_TRUE(QTest::qWaitForWindowExposed(window_.get()));
   }
@@ -443,6 +448,119 @@ TEST_F(MainWindowTest, CameraPathIsBuiltSavedLoadedAndRendered) {
   EXPECT_TRUE(window_->message().contains("Cancelled"));
   Click("add_keyframe_button");  // usable again
   EXPECT_EQ(window_->path_panel()->keyframes().size(), 4u);
+}
+
+// Mean absolute difference of neighbouring pixels (grey levels): an upsampled live
+// frame has less of it than the sharpened one.
+double Sharpness(const QImage& image) {
+  const QImage grey = image.convertToFormat(QImage::Format_Grayscale8);
+  double sum = 0;
+  int64_t n = 0;
+  for (int y = 0; y + 1 < grey.height(); ++y) {
+    const uchar* row = grey.constScanLine(y);
+    const uchar* below = grey.constScanLine(y + 1);
+    for (int x = 0; x + 1 < grey.width(); ++x) {
+      sum += std::abs(row[x + 1] - row[x]) + std::abs(below[x] - row[x]);
+      n += 2;
+    }
+  }
+  return sum / std::max<int64_t>(n, 1);
+}
+
+// Sends a left-button drag to the 3D view as a mouse would, one move every 30 ms.
+void Drag(QWidget* view, QPoint from, QPoint to, int steps,
+          const std::function<void(int)>& after_step) {
+  QTest::mousePress(view, Qt::LeftButton, Qt::NoModifier, from);
+  for (int i = 1; i <= steps; ++i) {
+    const QPoint p = from + (to - from) * i / steps;
+    QMouseEvent move(QEvent::MouseMove, p, view->mapToGlobal(p), Qt::NoButton,
+                     Qt::LeftButton, Qt::NoModifier);
+    QApplication::sendEvent(view, &move);
+    QTest::qWait(30);
+    if (after_step) after_step(i);
+  }
+  QTest::mouseRelease(view, Qt::LeftButton, Qt::NoModifier, to);
+}
+
+// The live view as a person uses it: open a workspace, drag the camera, see the view
+// rendered from the photos follow the mouse at a reduced resolution, let go, see it
+// sharpen to the full size; then Render is still the command line's.
+TEST_F(MainWindowTest, LiveViewFollowsTheMouseAndSharpensWhenItStops) {
+  // Photos larger than the live frames, so that sharpening shows.
+  TempDir sharp;
+  SyntheticSceneOptions options;
+  options.seed = 5;
+  options.num_views = 8;
+  options.width = 640;
+  options.height = 480;
+  options.num_sparse_points = 500;
+  options.write_proxy_mesh = true;
+  GenerateSyntheticScene(options, sharp.path());
+  window_->SetLiveView(true);
+  OpenWorkspace(sharp.path());
+  ASSERT_TRUE(window_->contents() && window_->contents()->can_render())
+      << window_->message().toStdString();
+  SceneView* view = window_->scene_view();
+  const auto complete = [this] {
+    return window_->live_frame() && window_->live_frame()->complete();
+  };
+  ASSERT_TRUE(WaitFor(complete));
+  EXPECT_TRUE(view->showing_live_image());
+  EXPECT_EQ(window_->live_frame()->view.camera.width, view->width());
+  EXPECT_EQ(window_->live_frame()->view.camera.height, view->height());
+  const QImage still = view->grabFramebuffer();
+  const uint64_t first_pose = window_->live_frame()->pose_id;
+
+  // Dragging: live frames of new poses, smaller than the view, the caption says so.
+  QImage moving;
+  int live_frames = 0;
+  uint64_t last_live_pose = first_pose;
+  const QPoint centre(view->width() / 2, view->height() / 2);
+  Drag(view, centre, centre + QPoint(view->width() / 6, view->height() / 20), 20,
+       [&](int) {
+         const auto& frame = window_->live_frame();
+         if (frame && frame->level == 0 && frame->pose_id != last_live_pose) {
+           ++live_frames;
+           last_live_pose = frame->pose_id;
+           moving = view->grabFramebuffer();
+           EXPECT_LT(frame->view.camera.width, view->width());
+           EXPECT_TRUE(view->live_caption().startsWith("Live: ulr at"))
+               << view->live_caption().toStdString();
+         }
+       });
+  std::printf("live frames while dragging 20 moves of 30 ms: %d, %.0f fps at the end\n",
+              live_frames, window_->live_fps());
+  EXPECT_GE(live_frames, 2);
+  ASSERT_FALSE(moving.isNull());
+  EXPECT_GT(DifferingPixels(moving, still), moving.width() * moving.height() / 10)
+      << "the live view did not change with the camera";
+
+  // Stopped: it sharpens to the full size, the last frame the chosen method's.
+  ASSERT_TRUE(WaitFor(complete));
+  EXPECT_GT(window_->live_frame()->pose_id, first_pose);
+  const QImage sharpened = view->grabFramebuffer();
+  EXPECT_TRUE(view->live_caption().startsWith("ulr at"))
+      << view->live_caption().toStdString();
+  std::printf("sharpness (mean neighbour difference): moving %.2f, sharpened %.2f\n",
+              Sharpness(moving), Sharpness(sharpened));
+  EXPECT_GT(Sharpness(sharpened), 1.08 * Sharpness(moving));
+  if (const char* dir = std::getenv("FVS_UI_SCREENSHOT_DIR")) {
+    moving.save(QString(dir) + "/gui_live_moving.png", "PNG", 0);
+    sharpened.save(QString(dir) + "/gui_live_sharp.png", "PNG", 0);
+  }
+
+  // Switched off, the 3D view shows the scene again; switched on, the view again.
+  Action("action_live_view")->trigger();
+  EXPECT_FALSE(window_->live_view());
+  EXPECT_FALSE(view->showing_live_image());
+  Action("action_live_view")->trigger();
+  EXPECT_TRUE(view->showing_live_image());
+
+  // Render pauses the live view and gives the command line's render of the chosen size.
+  Click("render_button");
+  ASSERT_TRUE(WaitIdle());
+  ASSERT_NE(window_->last_render(), nullptr) << window_->message().toStdString();
+  EXPECT_FALSE(window_->message_is_error()) << window_->message().toStdString();
 }
 
 }  // namespace
