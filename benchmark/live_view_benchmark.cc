@@ -117,16 +117,23 @@ int main(int argc, char** argv) {
       const auto levels =
           fvs::ui::LiveLevels(scale, width, height, final_request, options);
       double total = 0, psnr = 0;
+      fvs::RenderTimings split;
       for (size_t i = 0; i < poses.size(); ++i) {
         const auto& req = levels.front().request;
         const auto view = fvs::ui::RenderNovelView(
             scene, fvs::ui::TargetCameraFor(poses[i], req.width, req.height), req);
         total += view.seconds;
+        split.depth_s += view.result.timings.depth_s / poses.size();
+        split.selection_s += view.result.timings.selection_s / poses.size();
+        split.warp_s += view.result.timings.warp_s / poses.size();
+        split.blend_s += view.result.timings.blend_s / poses.size();
         psnr += PsnrAgainst(view.result.color, full[i]);
       }
       const auto& req = levels.front().request;
-      std::printf("%6.2f %5dx%-4d %9.4f %7.1f %10.2f\n", scale, req.width, req.height,
-                  total / poses.size(), poses.size() / total, psnr / poses.size());
+      std::printf("%6.2f %5dx%-4d %9.4f %7.1f %10.2f   %.4f / %.4f / %.4f / %.4f\n", scale,
+                  req.width, req.height, total / poses.size(), poses.size() / total,
+                  psnr / poses.size(), split.depth_s, split.selection_s, split.warp_s,
+                  split.blend_s);
     }
 
     // 2. The orbit through LiveRenderer, as the window drives it.

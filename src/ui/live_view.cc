@@ -22,6 +22,7 @@ void LiveViewOptions::Check() const {
               initial_scale <= max_live_scale && max_live_scale < 1,
           "live scales", "need 0 < min_scale <= initial_scale <= max_live_scale < 1");
   Require(live_max_sources >= 0, "live_max_sources", "must be >= 0");
+  Require(live_selection_stride >= 1, "live_selection_stride", "must be >= 1");
   Require(settle_seconds >= 0, "live settle_seconds", "must be >= 0");
 }
 
@@ -54,6 +55,7 @@ std::vector<LiveLevel> LiveLevels(double live_scale, int full_width, int full_he
     sharpen.scene_model_dir.clear();
   }
   NovelViewOptions live = sharpen;
+  live.selection_stride = options.live_selection_stride;
   if (options.live_max_sources > 0) {
     live.max_num_sources = std::min(live.max_num_sources, options.live_max_sources);
     if (live.num_sources > 0)

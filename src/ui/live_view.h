@@ -26,6 +26,8 @@ struct LiveViewOptions {
   double min_scale = 0.05, max_live_scale = 0.5, initial_scale = 0.2;
   // The live frames: `ulr` with at most this many sources (0 = the final request's K).
   int live_max_sources = 4;
+  // ...ranked on every n-th pixel (ranking all photos is most of a small frame's time).
+  int live_selection_stride = 2;
   // Seconds without a new pose before the view sharpens.
   double settle_seconds = 0.12;
   void Check() const;  // fvs::Error naming the setting out of range

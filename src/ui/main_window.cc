@@ -494,10 +494,18 @@ void MainWindow::SetLiveView(bool on) {
 bool MainWindow::live_view() const { return live_action_ && live_action_->isChecked(); }
 
 double MainWindow::live_fps() const {
+  // Frames over the span they arrived in, within the last second (a drag that began a
+  // moment ago has had less than a second of frames).
   const double now = SteadySeconds();
+  double first = now;
   int n = 0;
-  for (double t : live_arrivals_) n += now - t <= 1.0;
-  return n;
+  for (double t : live_arrivals_) {
+    if (now - t > 1.0) continue;
+    first = std::min(first, t);
+    ++n;
+  }
+  const double span = now - first;
+  return n >= 2 && span > 0 ? (n - 1) / span : 0.0;
 }
 
 void MainWindow::ResetLiveRenderer() {

@@ -18,6 +18,7 @@ RenderOptions NovelViewOptions::ToRenderOptions() const {
   RenderOptions options;
   options.num_sources = num_sources;
   options.max_num_sources = max_num_sources;
+  options.selection_stride = selection_stride;
   options.model_path = model_path;
   options.feature_cache_dir = feature_cache_dir;
   options.scene_model_dir = scene_model_dir;

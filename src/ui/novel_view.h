@@ -15,6 +15,7 @@ struct NovelViewOptions {
   std::string method = "ulr";
   int num_sources = 0;  // 0 = auto (RenderOptions::num_sources)
   int max_num_sources = RenderOptions().max_num_sources;  // of auto
+  int selection_stride = 1;  // RenderOptions::selection_stride (the live frames: 2)
   int width = 640;
   int height = 480;
   std::string model_path;  // weights, for the fvs methods
