@@ -62,7 +62,9 @@ std::vector<LiveLevel> LiveLevels(double live_scale, int full_width, int full_he
       live.num_sources = std::min(live.num_sources, options.live_max_sources);
   }
   std::vector<LiveLevel> levels;
-  for (double scale = live_scale; scale < 1; scale *= 2) {
+  // Doubling; a level past 0.65 of the full size would cost nearly the full frame and
+  // is left out.
+  for (double scale = live_scale; levels.empty() || scale <= 0.65; scale *= 2) {
     LiveLevel level;
     level.scale = scale;
     level.request = levels.empty() ? live : sharpen;

@@ -53,7 +53,8 @@ struct LiveLevel {
   NovelViewOptions request;  // method, K and size of this level
 };
 // The levels for a pose seen by a camera of full_width x full_height: the live scale,
-// then twice that, ... (with the live method), then the final request at full size.
+// then twice that, ... up to 0.65 of the full size (ulr, or the final method where it
+// needs no network), then the final request at full size.
 std::vector<LiveLevel> LiveLevels(double live_scale, int full_width, int full_height,
                                   const NovelViewOptions& final_request,
                                   const LiveViewOptions& options);

@@ -98,15 +98,17 @@ TEST(LiveLevelsTest, DoublesUpToTheFinalRequestAtFullSize) {
   final_request.method = "ulr";
   final_request.num_sources = 6;
   const auto levels = LiveLevels(0.2, 1000, 500, final_request, options);
-  ASSERT_EQ(levels.size(), 4u);  // 0.2, 0.4, 0.8, full
+  ASSERT_EQ(levels.size(), 3u);  // 0.2, 0.4, full (0.8 would cost nearly as much)
   EXPECT_EQ(levels[0].request.width, 200);
   EXPECT_EQ(levels[0].request.height, 100);
   EXPECT_EQ(levels[0].request.num_sources, options.live_max_sources);  // cheaper live
   EXPECT_EQ(levels[1].request.width, 400);
   EXPECT_EQ(levels[1].request.num_sources, 6);  // then the final K
-  EXPECT_EQ(levels[3].request.width, 1000);
-  EXPECT_EQ(levels[3].request.height, 500);
-  EXPECT_DOUBLE_EQ(levels[3].scale, 1.0);
+  EXPECT_EQ(levels[2].request.width, 1000);
+  EXPECT_EQ(levels[2].request.height, 500);
+  EXPECT_DOUBLE_EQ(levels[2].scale, 1.0);
+  // 0.1, 0.2, 0.4, full.
+  EXPECT_EQ(LiveLevels(0.1, 1000, 500, final_request, options).size(), 4u);
   // A network method sharpens with ulr and comes at full size only.
   final_request.method = "fvs";
   final_request.model_path = "w.safetensors";
