@@ -13,10 +13,10 @@
 
 #include "colmap_ext/image_io.h"
 #include "fvs/path/camera_path.h"
-#include "fvs/synthetic/generate.h"
 #include "fvs/util/cancel.h"
 #include "fvs/util/parallel.h"
 #include "support/test_support.h"
+#include "ui/ui_test_scene.h"
 #include "ui/workspace_contents.h"
 
 namespace fvs::ui {
@@ -124,14 +124,7 @@ class LiveRendererTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new TempDir();
-    SyntheticSceneOptions options;
-    options.seed = 11;
-    options.num_views = 8;
-    options.width = 320;
-    options.height = 240;
-    options.num_sparse_points = 500;
-    options.write_proxy_mesh = true;
-    GenerateSyntheticScene(options, dir_->path());
+    GenerateUiTestScene(dir_->path(), 11, 320, 240);
     contents_ = new WorkspaceContents(LoadWorkspace(dir_->path()));
   }
   static void TearDownTestSuite() {

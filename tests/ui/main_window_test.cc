@@ -29,13 +29,13 @@
 #include "fvs/path/camera_path.h"
 #include "fvs/path/video.h"
 #include "fvs/scene/photo_quality.h"
-#include "fvs/synthetic/generate.h"
 #include "fvs/util/folder_lock.h"
 #include "support/test_support.h"
 #include "ui/image_view.h"
 #include "ui/live_view.h"
 #include "ui/path_panel.h"
 #include "ui/scene_view.h"
+#include "ui/ui_test_scene.h"
 
 namespace fvs::ui {
 namespace {
@@ -93,14 +93,7 @@ class MainWindowTest : public ::testing::Test {
     static char* argv[] = {name, nullptr};
     app_ = new QApplication(argc, argv);
     workspace_ = new TempDir();
-    SyntheticSceneOptions options;
-    options.seed = 7;
-    options.num_views = 8;
-    options.width = 160;
-    options.height = 120;
-    options.num_sparse_points = 500;
-    options.write_proxy_mesh = true;
-    GenerateSyntheticScene(options, workspace_->path());
+    GenerateUiTestScene(workspace_->path(), 7, 160, 120);
   }
   static void TearDownTestSuite() {
     delete workspace_;
@@ -489,14 +482,7 @@ void Drag(QWidget* view, QPoint from, QPoint to, int steps,
 TEST_F(MainWindowTest, LiveViewFollowsTheMouseAndSharpensWhenItStops) {
   // Photos larger than the live frames, so that sharpening shows.
   TempDir sharp;
-  SyntheticSceneOptions options;
-  options.seed = 5;
-  options.num_views = 8;
-  options.width = 640;
-  options.height = 480;
-  options.num_sparse_points = 500;
-  options.write_proxy_mesh = true;
-  GenerateSyntheticScene(options, sharp.path());
+  GenerateUiTestScene(sharp.path(), 5, 640, 480);
   window_->SetLiveView(true);
   OpenWorkspace(sharp.path());
   ASSERT_TRUE(window_->contents() && window_->contents()->can_render())

@@ -7,8 +7,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
-#include "ui/workspace_contents.h"
 #include "geometry/geometry_test_util.h"
+#include "ui/workspace_contents.h"
 
 namespace fvs::ui {
 namespace {
