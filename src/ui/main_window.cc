@@ -25,6 +25,7 @@
 #include "fvs/render/method.h"
 #include "fvs/scene/photo_quality.h"
 #include "fvs/scene/scene.h"
+#include "fvs/util/cancel.h"
 #include "fvs/util/error.h"
 #include "fvs/util/folder_lock.h"
 #include "ui/live_view.h"
@@ -454,8 +455,11 @@ void MainWindow::RenderCurrentView() {
           .arg(QString::fromStdString(request.method))
           .arg(request.width)
           .arg(request.height),
-      [this, scene, contents, camera, request](const TaskRunner::Control&,
+      [this, scene, contents, camera, request](const TaskRunner::Control& control,
                                                const TaskRunner::ProgressFn&) {
+        // Cancel stops the render within a row of work (util/cancel.h); the Cancelled
+        // it throws ends the task, whose result the runner drops.
+        const CancelScope scope(&control.cancelled);
         auto view = std::make_shared<const RenderedView>(
             RenderNovelView(*scene, camera, request));
         return TaskRunner::Continuation([this, view, contents] {
@@ -472,7 +476,7 @@ void MainWindow::CancelTask() {
   if (!runner_->busy()) return;
   ShowNote("Cancelled: " + runner_->label() +
            (runner_->label().startsWith("Rendering")
-                ? " (the view being rendered finishes in the background and is dropped)"
+                ? " (the render stops and its result is dropped)"
                 : ""));
   runner_->Cancel();
 }

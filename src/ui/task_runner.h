@@ -3,7 +3,8 @@
 // the continuation that shows its result, which runs later on the GUI thread. Cancel()
 // abandons the running task at once (its continuation is dropped, the window is usable
 // again); the work itself stops where it next checks `cancelled` (between frames of a
-// path) or runs to its end in the background (a single Render is not interruptible).
+// path, or in every ParallelFor of a render run under a CancelScope on it) or runs to
+// its end in the background.
 #pragma once
 
 #include <QObject>
