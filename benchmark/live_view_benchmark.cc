@@ -130,10 +130,10 @@ int main(int argc, char** argv) {
         psnr += PsnrAgainst(view.result.color, full[i]);
       }
       const auto& req = levels.front().request;
-      std::printf("%6.2f %5dx%-4d %9.4f %7.1f %10.2f   %.4f / %.4f / %.4f / %.4f\n", scale,
-                  req.width, req.height, total / poses.size(), poses.size() / total,
-                  psnr / poses.size(), split.depth_s, split.selection_s, split.warp_s,
-                  split.blend_s);
+      std::printf("%6.2f %5dx%-4d %9.4f %7.1f %10.2f   %.4f / %.4f / %.4f / %.4f\n",
+                  scale, req.width, req.height, total / poses.size(),
+                  poses.size() / total, psnr / poses.size(), split.depth_s,
+                  split.selection_s, split.warp_s, split.blend_s);
     }
 
     // 2. The orbit through LiveRenderer, as the window drives it.
@@ -152,12 +152,14 @@ int main(int argc, char** argv) {
         });
     const double t0 = fvs::ui::SteadySeconds();
     uint64_t last_id = 0;
+    std::vector<std::pair<uint64_t, double>> requests;  // pose id, when asked for
     fvs::PinholeCamera last_pose;
     for (int step = 0;; ++step) {
       const double t = step / 30.0;
       if (t > seconds) break;
       last_pose = OrbitPose(start, contents.up, t, amplitude, width, height);
       last_id = live.Request(last_pose, final_request);
+      requests.emplace_back(last_id, fvs::ui::SteadySeconds());
       std::this_thread::sleep_until(
           std::chrono::steady_clock::now() +
           std::chrono::duration<double>(t0 + (step + 1) / 30.0 -
@@ -186,6 +188,23 @@ int main(int argc, char** argv) {
       scale_sum += frames[i]->scale;
     }
     const double span = t_stop - t0 - 1.0;
+    // Camera change -> the first frame that shows it or a later pose (most poses are
+    // superseded before the thread is free: their change shows in a later pose's frame).
+    double change_sum = 0, change_max = 0;
+    int changes = 0;
+    for (const auto& [id, asked] : requests) {
+      if (asked - t0 < 1.0) continue;
+      for (size_t i = 0; i < frames.size(); ++i) {
+        if (frames[i]->pose_id < id) continue;
+        change_sum += arrival[i] - asked;
+        change_max = std::max(change_max, arrival[i] - asked);
+        ++changes;
+        break;
+      }
+    }
+    std::printf(
+        "camera change -> first frame showing it: mean %.3f s, max %.3f s (%d changes)\n",
+        changes ? change_sum / changes : 0.0, change_max, changes);
     std::printf(
         "\norbit: %.1f s at 30 poses/s (first second not counted): %.1f live frames "
         "per second, latency pose -> frame mean %.3f s, max %.3f s, mean live "
