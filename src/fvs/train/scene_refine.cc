@@ -1,5 +1,6 @@
 #include "fvs/train/scene_refine.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -26,6 +27,8 @@ struct RefineState {
   double minutes_done = 0;  // budget of the last finished run (0: none)
   double seconds = 0;       // wall time of all runs, packing included
   int steps = 0;
+  // Writing the result and the source depths, as the last run measured them (0: none).
+  double finish_seconds = 0;
 };
 
 RefineState ReadState(const fs::path& file) {
@@ -38,6 +41,7 @@ RefineState ReadState(const fs::path& file) {
     s.minutes_done = j.at("minutes_done").get<double>();
     s.seconds = j.at("seconds").get<double>();
     s.steps = j.at("steps").get<int>();
+    s.finish_seconds = j.value("finish_seconds", 0.0);  // absent before session 28
   } catch (const std::exception&) {
     return RefineState();  // unreadable: start afresh
   }
@@ -49,7 +53,8 @@ void WriteState(const fs::path& file, const RefineState& s) {
                             {"pack_scale", s.pack_scale},
                             {"minutes_done", s.minutes_done},
                             {"seconds", s.seconds},
-                            {"steps", s.steps}};
+                            {"steps", s.steps},
+                            {"finish_seconds", s.finish_seconds}};
   WriteFileAtomic(file.string(), [&](std::ostream& out) { out << j.dump(2) << "\n"; });
 }
 
@@ -172,11 +177,14 @@ SceneRefineSummary RunSceneRefine(const SceneRefineOptions& o) {
   if (offsets.empty()) offsets = SavedOffsets(result_path, world_base);
 
   // What is left of the budget, less what writing the result and the source depths of
-  // every view will take (about half of what the setup took, at least 2 s, at most a
-  // fifth of the budget).
+  // every view will take: about half of what the setup took, or half as much again as
+  // the last run's finish took (a continued run has next to no setup; its finish took
+  // 44 s on a loaded machine where 2 s had been kept), at least 2 s, at most a fifth of
+  // the budget.
   const double spent_before = state.seconds;
   const double reserve =
-      std::min(0.2 * o.minutes * 60, std::max(2.0, 0.5 * timer.Seconds()));
+      std::min(0.2 * o.minutes * 60,
+               std::max({2.0, 0.5 * timer.Seconds(), 1.5 * state.finish_seconds}));
   MeshPhotoRefineOptions refine = o.refine;
   refine.quiet = o.quiet;
   refine.seconds = o.minutes * 60 - spent_before - timer.Seconds() - reserve;
@@ -194,6 +202,7 @@ SceneRefineSummary RunSceneRefine(const SceneRefineOptions& o) {
     WriteState(state_file, now);
   };
   summary.last = RefineMeshByPhotoConsistency(scene, base, refine, offsets);
+  const double finish_start = timer.Seconds();
   WriteMesh(result_path, Shifted(summary.last.mesh, scene.origin));
   fs::remove(root / "checkpoint.ply");
   // The source depths of every view from the new mesh, so the first render does not
@@ -203,6 +212,7 @@ SceneRefineSummary RunSceneRefine(const SceneRefineOptions& o) {
   Scene::Load(o.workspace_path, load);
   state.steps += summary.last.steps;
   state.seconds = spent_before + timer.Seconds();
+  state.finish_seconds = timer.Seconds() - finish_start;
   state.minutes_done = o.minutes;
   WriteCard(root / "refine.json", o, state, base_path, summary.last);
   WriteState(state_file, state);
