@@ -88,6 +88,9 @@ int main(int argc, char** argv) {
                                       0.25 * contents.scale));
     fvs::ui::NovelViewOptions final_request;
     final_request.method = method;
+    fvs::ui::NovelViewOptions full_request = final_request;  // at the full size
+    full_request.width = width;
+    full_request.height = height;
     fvs::ui::LiveViewOptions options;
     options.min_fps = min_fps;
     const fvs::Scene& scene = *contents.scene;
@@ -100,10 +103,7 @@ int main(int argc, char** argv) {
     std::vector<fvs::Image> full;
     double full_seconds = 0;
     for (const auto& pose : poses) {
-      fvs::ui::NovelViewOptions r = final_request;
-      r.width = width;
-      r.height = height;
-      const auto view = fvs::ui::RenderNovelView(scene, pose, r);
+      const auto view = fvs::ui::RenderNovelView(scene, pose, full_request);
       full.push_back(view.result.color);
       full_seconds += view.seconds;
     }
@@ -228,10 +228,7 @@ int main(int argc, char** argv) {
                   frames[i]->complete() ? " (complete)" : "");
     }
     // The complete frame is the command line's render at that pose.
-    fvs::ui::NovelViewOptions r = final_request;
-    r.width = width;
-    r.height = height;
-    const auto reference = fvs::ui::RenderNovelView(scene, last_pose, r);
+    const auto reference = fvs::ui::RenderNovelView(scene, last_pose, full_request);
     double max_diff = 0;
     for (size_t i = 0; i < complete.data.size(); ++i)
       max_diff = std::max<double>(

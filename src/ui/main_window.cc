@@ -28,6 +28,7 @@
 #include "fvs/util/cancel.h"
 #include "fvs/util/error.h"
 #include "fvs/util/folder_lock.h"
+#include "ui/image_view.h"
 #include "ui/live_view.h"
 #include "ui/path_panel.h"
 #include "ui/result_panel.h"
@@ -556,14 +557,6 @@ void MainWindow::ShowLiveFrame(std::shared_ptr<const LiveFrame> frame) {
   live_frame_ = frame;
   const RenderedView& view = frame->view;
   const Image& color = view.result.color;
-  QImage image(color.width, color.height, QImage::Format_RGB888);
-  for (int y = 0; y < color.height; ++y) {
-    uchar* row = image.scanLine(y);
-    for (int i = 0; i < 3 * color.width; ++i) {
-      const float v = color.data[static_cast<size_t>(y) * 3 * color.width + i];
-      row[i] = static_cast<uchar>(std::lround(std::clamp(v, 0.f, 1.f) * 255.f));
-    }
-  }
   const QString size = QString("%1x%2").arg(color.width).arg(color.height);
   const QString method = QString::fromStdString(view.method);
   QString caption;
@@ -583,7 +576,7 @@ void MainWindow::ShowLiveFrame(std::shared_ptr<const LiveFrame> frame) {
                   .arg(view.num_sources > 0 ? QString::number(view.num_sources) : "auto")
                   .arg(view.seconds, 0, 'f', 2);
   }
-  scene_view_->SetLiveImage(std::move(image), caption);
+  scene_view_->SetLiveImage(ToQImage(color), caption);
 }
 
 void MainWindow::UpdateEnabled() {
