@@ -451,6 +451,49 @@ TEST(WarpTest, SampleBilinear) {
   EXPECT_FLOAT_EQ(out, 0.f);
 }
 
+TEST(WarpTest, SampleBicubic) {
+  // A quadratic along x (two channels: x^2 and 10 - x) is reproduced exactly between
+  // interior pixel centres, which bilinear cannot do for the square.
+  Image image(8, 3, 2);
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 8; ++x) {
+      image.at(x, y, 0) = static_cast<float>(x * x);
+      image.at(x, y, 1) = static_cast<float>(10 - x);
+    }
+  }
+  float out[2];
+  for (const double x : {1.0, 2.25, 3.5, 4.8, 5.0}) {
+    SampleBicubic(image, x + 0.5, 1.5, out);
+    EXPECT_NEAR(out[0], x * x, 1e-4) << x;
+    EXPECT_NEAR(out[1], 10 - x, 1e-5) << x;
+    float linear[2];
+    SampleBilinear(image, x + 0.5, 1.5, linear);
+    if (x != std::floor(x)) EXPECT_GT(linear[0], x * x + 0.01) << x;
+  }
+  // Outside the centres: the border, as SampleBilinear's clamp_to_border.
+  SampleBicubic(image, -3.0, 1.5, out);
+  EXPECT_FLOAT_EQ(out[0], 0.f);
+  SampleBicubic(image, 100.0, -7.0, out);
+  EXPECT_FLOAT_EQ(out[0], 49.f);
+  EXPECT_FLOAT_EQ(out[1], 3.f);
+  // Non-finite coordinates and an empty image give 0, never NaN.
+  SampleBicubic(image, std::nan(""), 1.5, out);
+  EXPECT_EQ(out[0], 0.f);
+  SampleBicubic(image, 1.5, std::numeric_limits<double>::infinity(), out);
+  EXPECT_EQ(out[1], 0.f);
+  SampleBicubic(Image(), 0.5, 0.5, out);
+  // A step edge overshoots by at most 7.4 % of the step (Catmull-Rom's 2 / 27: callers
+  // clamp to [0, 1]).
+  Image step(6, 1, 1);
+  step.data = {0.f, 0.f, 0.f, 1.f, 1.f, 1.f};
+  for (double u = 0.5; u <= 5.5; u += 0.125) {
+    float v;
+    SampleBicubic(step, u, 0.5, &v);
+    EXPECT_GE(v, -0.075f);
+    EXPECT_LE(v, 1.075f);
+  }
+}
+
 TEST(WarpTest, RejectsMismatchedSizes) {
   const PinholeCamera cam = SimpleCamera(20, 10, 18);
   EXPECT_THROW(ComputeWarpMap(cam, Image(19, 10, 1), cam, Image(20, 10, 1)), Error);

@@ -9,6 +9,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <set>
+#include <string>
+#include <vector>
 
 #ifdef FVS_HAVE_CGAL
 
@@ -287,6 +291,37 @@ TEST(DelaunayMesher, BadInputAndOptionsAreRejected) {
   options.quality_regularization = -1;
   EXPECT_THROW(options.Check(), Error);
   EXPECT_NO_THROW(TestOptions().Check());
+}
+
+// prepare's meshing fingerprint: "" at the defaults (a workspace meshed before the
+// options could be set is not meshed again), and every option that shapes the mesh
+// changes it.
+TEST(DelaunayMesher, OptionsStringNamesWhatShapesTheMesh) {
+  EXPECT_EQ(DelaunayMeshingOptions().ToString(), "");
+  DelaunayMeshingOptions threads;
+  threads.num_threads = 1;
+  EXPECT_EQ(threads.ToString(), "");
+  const std::vector<std::function<void(DelaunayMeshingOptions*)>> changes = {
+      [](DelaunayMeshingOptions* o) { o->max_proj_dist = 5; },
+      [](DelaunayMeshingOptions* o) { o->max_depth_dist = 0.01; },
+      [](DelaunayMeshingOptions* o) { o->visibility_sigma = 2; },
+      [](DelaunayMeshingOptions* o) { o->distance_sigma_factor = 2; },
+      [](DelaunayMeshingOptions* o) { o->quality_regularization = 0.5; },
+      [](DelaunayMeshingOptions* o) { o->max_side_length_factor = 10; },
+      [](DelaunayMeshingOptions* o) { o->max_side_length_percentile = 90; },
+      [](DelaunayMeshingOptions* o) { o->isolated_point_neighbors = 0; },
+      [](DelaunayMeshingOptions* o) { o->isolated_point_factor = 3; },
+      [](DelaunayMeshingOptions* o) { o->max_side_spacing_factor = 0; },
+      [](DelaunayMeshingOptions* o) { o->sparse_min_track_length = 3; },
+      [](DelaunayMeshingOptions* o) { o->sparse_max_error = 1; }};
+  std::set<std::string> seen;
+  for (const auto& change : changes) {
+    DelaunayMeshingOptions o;
+    change(&o);
+    EXPECT_NE(o.ToString(), "");
+    seen.insert(o.ToString());
+  }
+  EXPECT_EQ(seen.size(), changes.size());
 }
 
 // --- The dense workspace: fused.ply + fused.ply.vis + sparse/ -> meshed-delaunay.ply ---

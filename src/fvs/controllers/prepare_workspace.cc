@@ -1,6 +1,7 @@
 #include "fvs/controllers/prepare_workspace.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <set>
@@ -188,7 +189,10 @@ void WorkspacePreparation::RunDenseStages(StageRunner* stages) {
               {ws_.StereoDir() + "/depth_maps"}, [&] { Stereo(); });
   stages->Run("fusion", {}, FusionFingerprint(c_.fusion_min_num_pixels),
               {ws_.FusedPath(), ws_.FusedVisPath()}, [&] { Fuse(); });
-  stages->Run("meshing", {}, builtin_mesher_ ? "builtin" : "colmap",
+  const std::string meshing = c_.meshing.ToString();
+  stages->Run("meshing", {},
+              std::string(builtin_mesher_ ? "builtin" : "colmap") +
+                  (meshing.empty() ? "" : " " + meshing),
               {ws_.DelaunayMeshPath()}, [&] { Mesh(); });
   stages->Run("mesh_refinement", {}, c_.refine.ToString(),
               {fvs_dir_ + "/refinement.json"},
@@ -334,13 +338,39 @@ void WorkspacePreparation::Fuse() {
 void WorkspacePreparation::Mesh() {
   if (builtin_mesher_) {
     // view_synthesis_mesher's defaults and output.
-    RunBuiltinMesher(c_.workspace_path, ws_.DelaunayMeshPath(),
-                     mvs::DelaunayMeshingOptions());
+    mvs::DelaunayMeshingOptions meshing = c_.meshing;
+    meshing.num_threads = c_.num_threads;
+    RunBuiltinMesher(c_.workspace_path, ws_.DelaunayMeshPath(), meshing);
     return;
   }
   const std::string out = tmp_dir_ + "/meshed-delaunay.ply";
-  colmap::RunColmap({"delaunay_mesher", "--input_path", c_.workspace_path, "--input_type",
-                     "dense", "--output_path", out});
+  const mvs::DelaunayMeshingOptions& m = c_.meshing;
+  const auto num = [](double x) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.17g", x);
+    return std::string(text);
+  };
+  colmap::RunColmap({"delaunay_mesher",
+                     "--input_path",
+                     c_.workspace_path,
+                     "--input_type",
+                     "dense",
+                     "--output_path",
+                     out,
+                     "--DelaunayMeshing.max_proj_dist",
+                     num(m.max_proj_dist),
+                     "--DelaunayMeshing.max_depth_dist",
+                     num(m.max_depth_dist),
+                     "--DelaunayMeshing.visibility_sigma",
+                     num(m.visibility_sigma),
+                     "--DelaunayMeshing.distance_sigma_factor",
+                     num(m.distance_sigma_factor),
+                     "--DelaunayMeshing.quality_regularization",
+                     num(m.quality_regularization),
+                     "--DelaunayMeshing.max_side_length_factor",
+                     num(m.max_side_length_factor),
+                     "--DelaunayMeshing.max_side_length_percentile",
+                     num(m.max_side_length_percentile)});
   MoveIntoPlace(out, ws_.DelaunayMeshPath());
 }
 
@@ -361,6 +391,7 @@ void PrepareWorkspaceOptions::Check() const {
   Require(stereo_max_image_size >= 0, who, "--Stereo.max_image_size must be >= 0");
   Require(fusion_min_num_pixels >= 1, who, "--Fusion.min_num_pixels must be >= 1");
   planar_prior.Check();
+  meshing.Check();
   refine.Check();
   photo_quality.Check();
   backdrop.Check();

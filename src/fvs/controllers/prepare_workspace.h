@@ -14,6 +14,7 @@
 
 #include <string>
 
+#include "fvs/mvs/delaunay.h"
 #include "fvs/mvs/mesh_refinement.h"
 #include "fvs/mvs/planar_prior.h"
 #include "fvs/scene/backdrop.h"
@@ -36,6 +37,9 @@ struct PrepareWorkspaceOptions {
   int fusion_min_num_pixels = 5;
   // The built-in stereo's fill of textureless and unconfirmed pixels (--PlanarPrior.*).
   mvs::PlanarPriorOptions planar_prior;
+  // The Delaunay graph-cut mesher (--DelaunayMeshing.*; num_threads comes from
+  // num_threads). The COLMAP backend gets the options COLMAP's delaunay_mesher has.
+  mvs::DelaunayMeshingOptions meshing;
   // The mesh refined by photo-consistency (--Refine.*).
   mvs::MeshRefinementOptions refine;
   // What lies beyond the mesh, fitted to the photos before infinity (--Backdrop.*).

@@ -9,6 +9,9 @@ void AddRenderEngineFlags(OptionManager* options, RenderOptions* render) {
                       "relative depth tolerance for ranking sources");
   options->AddDefault("warp_tolerance", &render->warp_tolerance,
                       "relative occlusion tolerance when warping");
+  options->AddDefault("interpolation", &render->interpolation,
+                      "ulr and nearest: how a source photo is sampled, bilinear or "
+                      "bicubic (network methods: bilinear)");
   options->AddDefault("fill_holes", &render->fill_holes,
                       "fill pixels no source sees from the covered pixels around them "
                       "(0: leave them black; reports count them either way)");

@@ -13,6 +13,7 @@
 #include "colmap_ext/workspace.h"
 #include "fvs/controllers/workspace_stages.h"
 #include "fvs/exe/command_registry.h"
+#include "fvs/exe/stereo_flags.h"
 #include "fvs/mvs/delaunay.h"
 #include "fvs/util/folder_lock.h"
 #include "fvs/util/option_manager.h"
@@ -35,39 +36,7 @@ int RunViewSynthesisMesher(int argc, char** argv) {
                       "COLMAP dense workspace with fused.ply, fused.ply.vis and sparse/");
   options.AddDefault("output_path", &output_path,
                      "output mesh (default: <workspace_path>/meshed-delaunay.ply)");
-  options.AddDefault("DelaunayMeshing.max_proj_dist", &o.max_proj_dist,
-                     "merge points that reproject within this many pixels of a cell's "
-                     "vertices in every image that sees them (0: keep all points)");
-  options.AddDefault("DelaunayMeshing.max_depth_dist", &o.max_depth_dist,
-                     "... and whose relative depth differs by less than this");
-  options.AddDefault("DelaunayMeshing.visibility_sigma", &o.visibility_sigma,
-                     "points seen by few images weigh less: 1 - exp(-n^2 / (2 sigma^2))");
-  options.AddDefault(
-      "DelaunayMeshing.distance_sigma_factor", &o.distance_sigma_factor,
-      "free-space falloff near a point, times the 25th percentile edge length");
-  options.AddDefault("DelaunayMeshing.quality_regularization", &o.quality_regularization,
-                     "weight of the surface-quality (smoothness) term");
-  options.AddDefault("DelaunayMeshing.max_side_length_factor", &o.max_side_length_factor,
-                     "drop faces whose longest side exceeds this factor times ...");
-  options.AddDefault("DelaunayMeshing.max_side_length_percentile",
-                     &o.max_side_length_percentile,
-                     "... this percentile of the faces' longest sides");
-  options.AddDefault("DelaunayMeshing.isolated_point_neighbors",
-                     &o.isolated_point_neighbors,
-                     "not in COLMAP: drop points far from their k nearest points before "
-                     "meshing (0: keep all)");
-  options.AddDefault("DelaunayMeshing.isolated_point_factor", &o.isolated_point_factor,
-                     "... farther than this factor times the median neighbour distance");
-  options.AddDefault("DelaunayMeshing.max_side_spacing_factor",
-                     &o.max_side_spacing_factor,
-                     "not in COLMAP: drop faces longer than this factor times the local "
-                     "point spacing at their vertices (0: off)");
-  options.AddDefault("DelaunayMeshing.sparse_min_track_length",
-                     &o.sparse_min_track_length,
-                     "not in COLMAP: add the SfM points seen by at least this many fused "
-                     "images (stereo/fusion.cfg; 0: fused points only)");
-  options.AddDefault("DelaunayMeshing.sparse_max_error", &o.sparse_max_error,
-                     "... whose reprojection error is at most this many pixels");
+  AddDelaunayMeshingFlags(&options, &o);
   options.AddDefault("DelaunayMeshing.num_threads", &o.num_threads,
                      "threads (-1: all cores)");
   if (!options.Parse(argc, argv)) return 0;

@@ -37,6 +37,7 @@ int RunPrepare(int argc, char** argv) {
   options.AddDefault("Stereo.max_image_size", &o.stereo_max_image_size,
                      "longest side for stereo (0 = undistorted size)");
   AddPlanarPriorFlags(&options, &o.planar_prior);
+  AddDelaunayMeshingFlags(&options, &o.meshing);
   options.AddDefault("Fusion.min_num_pixels", &o.fusion_min_num_pixels,
                      "views whose depths must agree on a fused point (COLMAP's "
                      "StereoFusion.min_num_pixels)");

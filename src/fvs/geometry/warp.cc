@@ -203,4 +203,34 @@ void SampleBilinear(const Image& image, double u, double v, float* out,
   }
 }
 
+void SampleBicubic(const Image& image, double u, double v, float* out) {
+  const int c = image.channels;
+  for (int k = 0; k < c; ++k) out[k] = 0.f;
+  double fx = u - 0.5, fy = v - 0.5;  // continuous index, pixel centres at integers
+  if (!(std::isfinite(fx) && std::isfinite(fy)) || image.empty()) return;
+  fx = std::clamp(fx, 0.0, image.width - 1.0);
+  fy = std::clamp(fy, 0.0, image.height - 1.0);
+  const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
+  // Catmull-Rom weights of the centres at offsets -1, 0, 1, 2 from x0 (they sum to 1).
+  const auto weights = [](double t, float* w) {
+    w[0] = static_cast<float>(((-0.5 * t + 1.0) * t - 0.5) * t);
+    w[1] = static_cast<float>((1.5 * t - 2.5) * t * t + 1.0);
+    w[2] = static_cast<float>(((-1.5 * t + 2.0) * t + 0.5) * t);
+    w[3] = static_cast<float>((0.5 * t - 0.5) * t * t);
+  };
+  float wx[4], wy[4];
+  weights(fx - x0, wx);
+  weights(fy - y0, wy);
+  int xs[4];
+  for (int n = 0; n < 4; ++n) xs[n] = std::clamp(x0 - 1 + n, 0, image.width - 1);
+  for (int m = 0; m < 4; ++m) {
+    const int y = std::clamp(y0 - 1 + m, 0, image.height - 1);
+    for (int n = 0; n < 4; ++n) {
+      const float weight = wy[m] * wx[n];
+      const float* p = image.data.data() + image.Index(xs[n], y);
+      for (int k = 0; k < c; ++k) out[k] += weight * p[k];
+    }
+  }
+}
+
 }  // namespace fvs

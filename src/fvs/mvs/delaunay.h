@@ -98,6 +98,9 @@ struct DelaunayMeshingOptions {
 
   // Throws fvs::Error("delaunay mesher", ...) naming the bad option.
   void Check() const;
+  // The options that shape the mesh (not num_threads), "" when all are the defaults: a
+  // stage fingerprint that stays what it was before the options could be set.
+  std::string ToString() const;
 };
 
 // The mesher's input, in world coordinates.

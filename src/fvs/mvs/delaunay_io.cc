@@ -126,6 +126,32 @@ void AppendSparsePoints(const colmap::Reconstruction& reconstruction,
 
 }  // namespace
 
+std::string DelaunayMeshingOptions::ToString() const {
+  const DelaunayMeshingOptions d;
+  if (max_proj_dist == d.max_proj_dist && max_depth_dist == d.max_depth_dist &&
+      visibility_sigma == d.visibility_sigma &&
+      distance_sigma_factor == d.distance_sigma_factor &&
+      quality_regularization == d.quality_regularization &&
+      max_side_length_factor == d.max_side_length_factor &&
+      max_side_length_percentile == d.max_side_length_percentile &&
+      isolated_point_neighbors == d.isolated_point_neighbors &&
+      isolated_point_factor == d.isolated_point_factor &&
+      max_side_spacing_factor == d.max_side_spacing_factor &&
+      sparse_min_track_length == d.sparse_min_track_length &&
+      sparse_max_error == d.sparse_max_error) {
+    return "";
+  }
+  std::ostringstream s;
+  s.precision(17);
+  s << "proj=" << max_proj_dist << " depth=" << max_depth_dist
+    << " visibility=" << visibility_sigma << " distance=" << distance_sigma_factor
+    << " quality=" << quality_regularization << " side=" << max_side_length_factor << "@"
+    << max_side_length_percentile << " isolated=" << isolated_point_neighbors << "x"
+    << isolated_point_factor << " spacing=" << max_side_spacing_factor
+    << " sparse=" << sparse_min_track_length << "@" << sparse_max_error;
+  return s.str();
+}
+
 void DelaunayMeshingOptions::Check() const {
   auto require = [](bool ok, const std::string& what) { Require(ok, kWho, what); };
   require(std::isfinite(max_proj_dist) && max_proj_dist >= 0,

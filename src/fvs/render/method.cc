@@ -29,6 +29,8 @@ void RenderOptions::Check() const {
   Require(ulr_resolution_weight >= 0 && std::isfinite(ulr_resolution_weight),
           "ulr_resolution_weight", "must be non-negative");
   Require(ulr_num_blend >= 1, "ulr_num_blend", "must be at least 1");
+  Require(interpolation == "bilinear" || interpolation == "bicubic", "--interpolation",
+          "'" + interpolation + "': must be bilinear or bicubic");
   Require(source_hysteresis >= 0 && std::isfinite(source_hysteresis),
           "--source_hysteresis", "must be finite and non-negative");
   Require(tile_size == -1 || tile_size == 0 || tile_size >= 8, "--tile_size",

@@ -43,8 +43,12 @@ struct RenderOptions {
   double warp_tolerance = 0.01;       // relative occlusion tolerance when warping
   int selection_stride = 1;           // test every n-th target pixel when ranking
   double ulr_resolution_weight =
-      0.2;                 // weight of the resolution penalty vs the angle (rad)
-  int ulr_num_blend = 4;   // ULR k-nearest: best sources blended per pixel
+      0.2;                // weight of the resolution penalty vs the angle (rad)
+  int ulr_num_blend = 4;  // ULR k-nearest: best sources blended per pixel
+  // How ulr and nearest sample a source photo's colour at a warped position: bilinear or
+  // bicubic (geometry/warp.h SampleBicubic). The network methods sample their features
+  // bilinearly (grid_sample) whatever this says.
+  std::string interpolation = "bilinear";
   int num_threads = 0;     // <= 0: DefaultNumThreads()
   std::string model_path;  // weights, for methods that need them
   // Network methods without model_path: <variant>.safetensors in this folder (a scene's

@@ -29,6 +29,7 @@ class NearestMethod : public PixelBlendMethod {
     if (!prepared.sources.empty()) {
       const Image& photo = scene.SourceImage(prepared.sources[0].view_index);
       const WarpMap& warp = prepared.warps[0];
+      const bool bicubic = options_.interpolation == "bicubic";
       ParallelFor(
           0, h,
           [&](int64_t y) {
@@ -36,8 +37,13 @@ class NearestMethod : public PixelBlendMethod {
             for (int x = 0; x < w; ++x) {
               const size_t i = static_cast<size_t>(y) * w + x;
               if (warp.valid_warp.data[i] <= 0) continue;
-              SampleBilinear(photo, warp.source_xy.data[2 * i],
-                             warp.source_xy.data[2 * i + 1], sample, true);
+              const double su = warp.source_xy.data[2 * i];
+              const double sv = warp.source_xy.data[2 * i + 1];
+              if (bicubic) {
+                SampleBicubic(photo, su, sv, sample);
+              } else {
+                SampleBilinear(photo, su, sv, sample, true);
+              }
               for (int c = 0; c < 3; ++c) {
                 const float v = std::isfinite(sample[c]) ? sample[c] : 0.f;
                 result.color.data[3 * i + c] = std::clamp(v, 0.f, 1.f);

@@ -35,6 +35,7 @@ class UlrMethod : public PixelBlendMethod {
     UlrOptions settings;
     settings.resolution_weight = options_.ulr_resolution_weight;
     settings.num_blend = options_.ulr_num_blend;
+    const bool bicubic = options_.interpolation == "bicubic";
     ParallelFor(
         0, h,
         [&](int64_t y) {
@@ -54,8 +55,13 @@ class UlrMethod : public PixelBlendMethod {
             for (int s = 0; s < n; ++s) {
               if (weights[s] <= 0) continue;
               const Image& src_xy = prepared.warps[s].source_xy;
-              SampleBilinear(*photos[s], src_xy.data[2 * i], src_xy.data[2 * i + 1],
-                             sample, true);
+              if (bicubic) {
+                SampleBicubic(*photos[s], src_xy.data[2 * i], src_xy.data[2 * i + 1],
+                              sample);
+              } else {
+                SampleBilinear(*photos[s], src_xy.data[2 * i], src_xy.data[2 * i + 1],
+                               sample, true);
+              }
               for (int c = 0; c < 3; ++c) rgb[c] += weights[s] * sample[c];
             }
             for (int c = 0; c < 3; ++c) {
