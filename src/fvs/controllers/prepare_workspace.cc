@@ -32,6 +32,14 @@ std::string FusionFingerprint(int min_num_pixels) {
   return min_num_pixels == 5 ? "" : "min_num_pixels=" + std::to_string(min_num_pixels);
 }
 
+// Without the face test, as before it existed: a workspace refined then is not refined
+// again.
+std::string RefinementFingerprint(const mvs::MeshRefinementOptions& refine,
+                                  const mvs::FaceConsistencyOptions& consistency) {
+  return refine.ToString() +
+         (consistency.enabled ? " " + consistency.ToString() : std::string());
+}
+
 // One run of the stages on resolved options: absolute paths, the holdout names, the
 // photos, and the matcher and backends the installed COLMAP decides.
 class WorkspacePreparation {
@@ -194,9 +202,9 @@ void WorkspacePreparation::RunDenseStages(StageRunner* stages) {
               std::string(builtin_mesher_ ? "builtin" : "colmap") +
                   (meshing.empty() ? "" : " " + meshing),
               {ws_.DelaunayMeshPath()}, [&] { Mesh(); });
-  stages->Run("mesh_refinement", {}, c_.refine.ToString(),
+  stages->Run("mesh_refinement", {}, RefinementFingerprint(c_.refine, c_.consistency),
               {fvs_dir_ + "/refinement.json"},
-              [&] { RefineProxyMesh(c_.workspace_path, c_.refine); });
+              [&] { RefineProxyMesh(c_.workspace_path, c_.refine, c_.consistency); });
   stages->Run("backdrop", {}, c_.backdrop.ToString(), {fvs_dir_ + "/backdrop.json"},
               [&] { BuildBackdrop(c_.workspace_path, c_.backdrop); });
   stages->Run("depth_cache", {}, "", {ws_.FvsDir() + "/depth"},
@@ -392,6 +400,7 @@ void PrepareWorkspaceOptions::Check() const {
   Require(fusion_min_num_pixels >= 1, who, "--Fusion.min_num_pixels must be >= 1");
   planar_prior.Check();
   meshing.Check();
+  consistency.Check();
   refine.Check();
   photo_quality.Check();
   backdrop.Check();

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "fvs/mvs/delaunay.h"
+#include "fvs/mvs/face_consistency.h"
 #include "fvs/mvs/mesh_refinement.h"
 #include "fvs/mvs/planar_prior.h"
 #include "fvs/scene/backdrop.h"
@@ -40,7 +41,9 @@ struct PrepareWorkspaceOptions {
   // The Delaunay graph-cut mesher (--DelaunayMeshing.*; num_threads comes from
   // num_threads). The COLMAP backend gets the options COLMAP's delaunay_mesher has.
   mvs::DelaunayMeshingOptions meshing;
-  // The mesh refined by photo-consistency (--Refine.*).
+  // The mesh refined by photo-consistency: faces the photos contradict removed
+  // (--Consistency.*), then vertices moved (--Refine.*, off by default).
+  mvs::FaceConsistencyOptions consistency;
   mvs::MeshRefinementOptions refine;
   // What lies beyond the mesh, fitted to the photos before infinity (--Backdrop.*).
   BackdropOptions backdrop;

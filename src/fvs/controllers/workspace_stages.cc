@@ -75,29 +75,46 @@ std::vector<View> ReadGeometryPhotos(const colmap::DenseWorkspace& ws) {
 }  // namespace
 
 void RefineProxyMesh(const std::string& workspace_path,
-                     const mvs::MeshRefinementOptions& options) {
+                     const mvs::MeshRefinementOptions& options,
+                     const mvs::FaceConsistencyOptions& consistency) {
   options.Check();
+  consistency.Check();
   const colmap::DenseWorkspace ws(workspace_path);
   nlohmann::json json;
   json["enabled"] = options.enabled;
   json["options"] = options.ToString();
-  if (!options.enabled) {
+  json["consistency"] = consistency.ToString();
+  if (!options.enabled && !consistency.enabled) {
     RemoveAll(ws.RefinedMeshPath());
     std::cerr << "mesh refinement: off\n";
   } else {
-    const auto views = ReadGeometryPhotos<mvs::MeshRefinementView>(ws);
-    const TriangleMesh mesh = ReadPlyMesh(ws.DelaunayMeshPath());
-    const mvs::MeshRefinementResult result = mvs::RefineMesh(views, mesh, options);
+    TriangleMesh mesh = ReadPlyMesh(ws.DelaunayMeshPath());
+    if (consistency.enabled) {
+      const auto views = ReadGeometryPhotos<mvs::FaceConsistencyView>(ws);
+      mvs::FaceConsistencyResult removed =
+          mvs::RemoveInconsistentFaces(views, mesh, consistency);
+      std::cerr << removed.Summary() << "; " << removed.seconds << " s\n";
+      json["faces_removed"] = removed.num_removed;
+      json["faces_judged"] = removed.num_judged;
+      json["removed_share"] = removed.removed_area_share;
+      json["consistency_seconds"] = removed.seconds;
+      mesh = std::move(removed.mesh);
+    }
+    if (options.enabled) {
+      const auto views = ReadGeometryPhotos<mvs::MeshRefinementView>(ws);
+      const mvs::MeshRefinementResult result = mvs::RefineMesh(views, mesh, options);
+      std::cerr << result.Summary() << "; " << result.seconds << " s\n";
+      json["iterations"] = result.num_iterations_run;
+      json["stopped_at_time_bound"] = result.stopped_at_time_bound;
+      json["data_share"] = {result.first_data_share, result.last_data_share};
+      json["ncc"] = {result.ncc_before, result.ncc_after};
+      json["median_move_pixels"] = result.median_move_pixels;
+      json["seconds"] = result.seconds;
+      mesh = result.mesh;
+    }
     PlyWriteOptions write;
     write.double_precision = true;  // a scene far from the origin
-    WritePlyMesh(ws.RefinedMeshPath(), result.mesh, write);
-    std::cerr << result.Summary() << "; " << result.seconds << " s\n";
-    json["iterations"] = result.num_iterations_run;
-    json["stopped_at_time_bound"] = result.stopped_at_time_bound;
-    json["data_share"] = {result.first_data_share, result.last_data_share};
-    json["ncc"] = {result.ncc_before, result.ncc_after};
-    json["median_move_pixels"] = result.median_move_pixels;
-    json["seconds"] = result.seconds;
+    WritePlyMesh(ws.RefinedMeshPath(), mesh, write);
   }
   WriteFileAtomic(ws.FvsDir() + "/refinement.json",
                   [&](std::ostream& out) { out << json.dump(2) << "\n"; });

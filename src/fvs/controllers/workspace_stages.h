@@ -7,6 +7,7 @@
 #include <string>
 
 #include "fvs/mvs/delaunay.h"
+#include "fvs/mvs/face_consistency.h"
 #include "fvs/mvs/mesh_refinement.h"
 #include "fvs/mvs/patch_match_stereo.h"
 #include "fvs/scene/backdrop.h"
@@ -24,13 +25,15 @@ void RunBuiltinStereo(const std::string& workspace_path,
 void RunBuiltinMesher(const std::string& workspace_path, const std::string& output_path,
                       const mvs::DelaunayMeshingOptions& options);
 
-// Refines W/meshed-delaunay.ply by photo-consistency (mvs/mesh_refinement.h) against the
-// photos of W that are not held out (W/fvs/holdout.txt): W/meshed-refined.ply, which the
-// renderers then use (DenseWorkspace::ProxyMeshPath), and its summary
-// W/fvs/refinement.json. Disabled, it removes W/meshed-refined.ply. Throws fvs::Error for
-// an unusable workspace.
+// Refines W/meshed-delaunay.ply by photo-consistency against the photos of W that are not
+// held out (W/fvs/holdout.txt): first the faces the photos contradict are removed
+// (mvs/face_consistency.h), then, if asked, the vertices move to where the photos agree
+// (mvs/mesh_refinement.h). Writes W/meshed-refined.ply, which the renderers then use,
+// and W/fvs/refinement.json. With both off it removes W/meshed-refined.ply. Throws
+// fvs::Error for bad options or unreadable input.
 void RefineProxyMesh(const std::string& workspace_path,
-                     const mvs::MeshRefinementOptions& options);
+                     const mvs::MeshRefinementOptions& options,
+                     const mvs::FaceConsistencyOptions& consistency);
 
 // Fits the backdrop (scene/backdrop.h) to the photos of W that are not held out
 // (W/fvs/holdout.txt) around the proxy mesh: W/fvs/backdrop.ply (world frame; no

@@ -9,6 +9,11 @@ void AddRenderEngineFlags(OptionManager* options, RenderOptions* render) {
                       "relative depth tolerance for ranking sources");
   options->AddDefault("warp_tolerance", &render->warp_tolerance,
                       "relative occlusion tolerance when warping");
+  options->AddDefault("ulr_num_blend", &render->ulr_num_blend,
+                      "ulr: the best sources blended per pixel (k-nearest; the rest of "
+                      "the K selected weigh 0 there)");
+  options->AddDefault("ulr_resolution_weight", &render->ulr_resolution_weight,
+                      "ulr: weight of the resolution penalty against the angle (rad)");
   options->AddDefault("interpolation", &render->interpolation,
                       "ulr and nearest: how a source photo is sampled, bilinear or "
                       "bicubic (network methods: bilinear)");

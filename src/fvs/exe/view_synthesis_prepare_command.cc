@@ -64,6 +64,22 @@ int RunPrepare(int argc, char** argv) {
                      "spacing of the photos ...");
   options.AddDefault("PhotoQuality.duplicate_degrees", &o.photo_quality.duplicate_degrees,
                      "... looking within this many degrees of each other");
+  options.AddDefault("Consistency.enabled", &o.consistency.enabled,
+                     "remove the mesh's faces the photos contradict: a surface across "
+                     "empty space shows different colours in different photos "
+                     "(mvs/face_consistency.h)");
+  options.AddDefault("Consistency.max_image_size", &o.consistency.max_image_size,
+                     "longest side of the photos compared");
+  options.AddDefault("Consistency.num_neighbors", &o.consistency.num_neighbors,
+                     "photos each photo is compared with");
+  options.AddDefault("Consistency.depth_tolerance", &o.consistency.depth_tolerance,
+                     "relative depth within which another photo's mesh depth says it "
+                     "sees the point");
+  options.AddDefault("Consistency.max_colour_difference",
+                     &o.consistency.max_colour_difference,
+                     "mean |RGB difference| (0-1) above which a face is removed");
+  options.AddDefault("Consistency.min_samples", &o.consistency.min_samples,
+                     "photo pixel pairs a face needs before it is judged");
   options.AddDefault("Refine.enabled", &o.refine.enabled,
                      "move the mesh's vertices to where the photos agree "
                      "(mvs/mesh_refinement.h; off: it did not pay on held-out views, "
