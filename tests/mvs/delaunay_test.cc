@@ -293,14 +293,17 @@ TEST(DelaunayMesher, BadInputAndOptionsAreRejected) {
   EXPECT_NO_THROW(TestOptions().Check());
 }
 
-// prepare's meshing fingerprint: "" at the defaults (a workspace meshed before the
-// options could be set is not meshed again), and every option that shapes the mesh
-// changes it.
+// prepare's meshing fingerprint: "" for the defaults before session 29 (the fingerprint
+// of the meshes made then), something else for today's defaults (so those meshes are made
+// again), and every option that shapes the mesh changes it.
 TEST(DelaunayMesher, OptionsStringNamesWhatShapesTheMesh) {
-  EXPECT_EQ(DelaunayMeshingOptions().ToString(), "");
-  DelaunayMeshingOptions threads;
-  threads.num_threads = 1;
-  EXPECT_EQ(threads.ToString(), "");
+  DelaunayMeshingOptions legacy;
+  legacy.max_proj_dist = 20;
+  legacy.max_side_spacing_factor = 10;
+  EXPECT_EQ(legacy.ToString(), "");
+  legacy.num_threads = 1;
+  EXPECT_EQ(legacy.ToString(), "");
+  EXPECT_NE(DelaunayMeshingOptions().ToString(), "");
   const std::vector<std::function<void(DelaunayMeshingOptions*)>> changes = {
       [](DelaunayMeshingOptions* o) { o->max_proj_dist = 5; },
       [](DelaunayMeshingOptions* o) { o->max_depth_dist = 0.01; },
@@ -316,7 +319,7 @@ TEST(DelaunayMesher, OptionsStringNamesWhatShapesTheMesh) {
       [](DelaunayMeshingOptions* o) { o->sparse_max_error = 1; }};
   std::set<std::string> seen;
   for (const auto& change : changes) {
-    DelaunayMeshingOptions o;
+    DelaunayMeshingOptions o = legacy;
     change(&o);
     EXPECT_NE(o.ToString(), "");
     seen.insert(o.ToString());

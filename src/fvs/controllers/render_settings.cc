@@ -88,6 +88,13 @@ std::string RenderSettingsJson(const RenderTargetsOptions& o) {
   json["temporal_blend"] = o.temporal.temporal_blend;
   json["fill_holes"] = o.render.fill_holes;
   if (o.render.use_blurry_sources) json["use_blurry_sources"] = true;
+  if (o.method == "ulr" || o.method == "nearest") {
+    json["interpolation"] = o.render.interpolation;
+  }
+  if (o.method == "ulr") {
+    json["ulr_num_blend"] = o.render.ulr_num_blend;
+    json["ulr_resolution_weight"] = o.render.ulr_resolution_weight;
+  }
   // Tiles change the network's context at their seams.
   if (TraitsOfMethod(o.method).needs_weights) {
     json["precision"] = o.render.precision;

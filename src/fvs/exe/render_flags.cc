@@ -15,8 +15,8 @@ void AddRenderEngineFlags(OptionManager* options, RenderOptions* render) {
   options->AddDefault("ulr_resolution_weight", &render->ulr_resolution_weight,
                       "ulr: weight of the resolution penalty against the angle (rad)");
   options->AddDefault("interpolation", &render->interpolation,
-                      "ulr and nearest: how a source photo is sampled, bilinear or "
-                      "bicubic (network methods: bilinear)");
+                      "ulr and nearest: how a source photo is sampled, bicubic or "
+                      "bilinear (network methods: bilinear)");
   options->AddDefault("fill_holes", &render->fill_holes,
                       "fill pixels no source sees from the covered pixels around them "
                       "(0: leave them black; reports count them either way)");

@@ -3,8 +3,9 @@
 // The built-in Delaunay graph-cut mesher (src/fvs/mvs/delaunay.h) on a COLMAP dense
 // workspace: W/fused.ply + W/fused.ply.vis + W/sparse (its SfM points too, see
 // --DelaunayMeshing.sparse_min_track_length) -> W/meshed-delaunay.ply, with the
-// options of COLMAP's delaunay_mesher (--DelaunayMeshing.*, same names and defaults), for
-// the COLMAP builds that lack CGAL (Debian's). Bad input: one error line, exit 1, no
+// options of COLMAP's delaunay_mesher (--DelaunayMeshing.*, same names; the defaults too
+// but max_proj_dist, 40 against COLMAP's 20, measured in mvs/delaunay.h), for the COLMAP
+// builds that lack CGAL (Debian's). Bad input: one error line, exit 1, no
 // output.
 #include <filesystem>
 #include <iostream>

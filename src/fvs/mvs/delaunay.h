@@ -57,8 +57,11 @@ constexpr bool DelaunayMesherAvailable() {
 
 struct DelaunayMeshingOptions {
   // Merge input points into one triangulation vertex when they reproject within this many
-  // pixels of all vertices of the cell they fall in (0 = keep every point).
-  double max_proj_dist = 20.0;
+  // pixels of all vertices of the cell they fall in (0 = keep every point). COLMAP: 20.
+  // 40 was best of 5, 20, 30, 40, 60 on the held-out views of five tuning scenes (with
+  // max_side_spacing_factor 0: doc/real_scenes.md, session 29); 5 was worst: more
+  // vertices carry more of the fused points' noise into the surface.
+  double max_proj_dist = 40.0;
   // ... and their depths differ by less than this fraction.
   double max_depth_dist = 0.05;
   // Weight of a point's rays: 1 - exp(-n^2 / (2 sigma^2)) for a point seen in n images,
@@ -81,8 +84,12 @@ struct DelaunayMeshingOptions {
   // Not in COLMAP: also drop faces whose longest side exceeds this factor x the largest
   // local point spacing (mean distance to the 8 nearest points) at its vertices. Faces
   // that bridge empty space between parts of the cloud fail it; faces in sparse regions,
-  // or joining a sparse region to a dense one, do not. 0 = off, as COLMAP.
-  double max_side_spacing_factor = 10.0;
+  // or joining a sparse region to a dense one, do not. 0 = off, as COLMAP, the default
+  // since the backdrop (scene/backdrop.h) fills what lies beyond the mesh: the faces it
+  // dropped were mostly the true surface across textureless parts (a white table top,
+  // a black dinosaur's flanks), and held-out views of the tuning scenes lost 0.2-2 dB
+  // by it (doc/real_scenes.md, session 29).
+  double max_side_spacing_factor = 0.0;
   // Not in COLMAP: the SfM points of W/sparse join the fused points, with their tracks as
   // visibility, when at least sparse_min_track_length of the fused images (those listed
   // in W/stereo/fusion.cfg, so photos held out of the geometry never count) see them
@@ -98,8 +105,10 @@ struct DelaunayMeshingOptions {
 
   // Throws fvs::Error("delaunay mesher", ...) naming the bad option.
   void Check() const;
-  // The options that shape the mesh (not num_threads), "" when all are the defaults: a
-  // stage fingerprint that stays what it was before the options could be set.
+  // The options that shape the mesh (not num_threads), for prepare's fingerprint; "" for
+  // the defaults before session 29 (max_proj_dist 20, max_side_spacing_factor 10), the
+  // fingerprint of meshes made before the options could be set, so those are meshed
+  // again with today's defaults and no others are.
   std::string ToString() const;
 };
 

@@ -127,7 +127,11 @@ void AppendSparsePoints(const colmap::Reconstruction& reconstruction,
 }  // namespace
 
 std::string DelaunayMeshingOptions::ToString() const {
-  const DelaunayMeshingOptions d;
+  // The defaults before session 29 (max_proj_dist 20, max_side_spacing_factor 10): the
+  // fingerprint of the meshes made before the options reached prepare.
+  DelaunayMeshingOptions d;
+  d.max_proj_dist = 20.0;
+  d.max_side_spacing_factor = 10.0;
   if (max_proj_dist == d.max_proj_dist && max_depth_dist == d.max_depth_dist &&
       visibility_sigma == d.visibility_sigma &&
       distance_sigma_factor == d.distance_sigma_factor &&

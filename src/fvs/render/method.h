@@ -45,10 +45,11 @@ struct RenderOptions {
   double ulr_resolution_weight =
       0.2;                // weight of the resolution penalty vs the angle (rad)
   int ulr_num_blend = 4;  // ULR k-nearest: best sources blended per pixel
-  // How ulr and nearest sample a source photo's colour at a warped position: bilinear or
-  // bicubic (geometry/warp.h SampleBicubic). The network methods sample their features
-  // bilinearly (grid_sample) whatever this says.
-  std::string interpolation = "bilinear";
+  // How ulr and nearest sample a source photo's colour at a warped position: bicubic
+  // (geometry/warp.h SampleBicubic) or bilinear. Bicubic gave lower LPIPS on 4 of the 5
+  // tuning scenes' held-out views at level PSNR (doc/real_scenes.md, session 29). The
+  // network methods sample their features bilinearly (grid_sample) whatever this says.
+  std::string interpolation = "bicubic";
   int num_threads = 0;     // <= 0: DefaultNumThreads()
   std::string model_path;  // weights, for methods that need them
   // Network methods without model_path: <variant>.safetensors in this folder (a scene's
