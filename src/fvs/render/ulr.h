@@ -1,6 +1,7 @@
 // Unstructured Lumigraph Rendering (Buehler et al., SIGGRAPH 2001) as a classical
 // baseline without a network: the K selected sources' colours, warped with the same
-// target depth and masks as the network sees, blended per pixel with ULR weights
+// target depth and masks as the network sees and sampled bicubically (or bilinearly, as
+// the network samples: RenderOptions::interpolation), blended per pixel with ULR weights
 // (net/ulr_weights.h, shared with the network's prior). Pixels without a surface are
 // blended from the sources that see them at infinity (geometry/warp.h); pixels no source
 // sees stay black (coverage 0).
