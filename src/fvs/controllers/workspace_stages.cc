@@ -89,8 +89,8 @@ void RefineProxyMesh(const std::string& workspace_path,
     std::cerr << "mesh refinement: off\n";
   } else {
     TriangleMesh mesh = ReadPlyMesh(ws.DelaunayMeshPath());
+    const auto views = ReadGeometryPhotos<mvs::MeshRefinementView>(ws);
     if (consistency.enabled) {
-      const auto views = ReadGeometryPhotos<mvs::FaceConsistencyView>(ws);
       mvs::FaceConsistencyResult removed =
           mvs::RemoveInconsistentFaces(views, mesh, consistency);
       std::cerr << removed.Summary() << "; " << removed.seconds << " s\n";
@@ -101,7 +101,6 @@ void RefineProxyMesh(const std::string& workspace_path,
       mesh = std::move(removed.mesh);
     }
     if (options.enabled) {
-      const auto views = ReadGeometryPhotos<mvs::MeshRefinementView>(ws);
       const mvs::MeshRefinementResult result = mvs::RefineMesh(views, mesh, options);
       std::cerr << result.Summary() << "; " << result.seconds << " s\n";
       json["iterations"] = result.num_iterations_run;

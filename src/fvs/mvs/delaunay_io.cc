@@ -126,34 +126,31 @@ void AppendSparsePoints(const colmap::Reconstruction& reconstruction,
 
 }  // namespace
 
+namespace {
+
+// Every option that shapes the mesh (not num_threads).
+std::string DescribeMeshing(const DelaunayMeshingOptions& o) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "proj=" << o.max_proj_dist << " depth=" << o.max_depth_dist
+    << " visibility=" << o.visibility_sigma << " distance=" << o.distance_sigma_factor
+    << " quality=" << o.quality_regularization << " side=" << o.max_side_length_factor
+    << "@" << o.max_side_length_percentile << " isolated=" << o.isolated_point_neighbors
+    << "x" << o.isolated_point_factor << " spacing=" << o.max_side_spacing_factor
+    << " sparse=" << o.sparse_min_track_length << "@" << o.sparse_max_error;
+  return s.str();
+}
+
+}  // namespace
+
 std::string DelaunayMeshingOptions::ToString() const {
   // The defaults before session 29 (max_proj_dist 20, max_side_spacing_factor 10): the
   // fingerprint of the meshes made before the options reached prepare.
-  DelaunayMeshingOptions d;
-  d.max_proj_dist = 20.0;
-  d.max_side_spacing_factor = 10.0;
-  if (max_proj_dist == d.max_proj_dist && max_depth_dist == d.max_depth_dist &&
-      visibility_sigma == d.visibility_sigma &&
-      distance_sigma_factor == d.distance_sigma_factor &&
-      quality_regularization == d.quality_regularization &&
-      max_side_length_factor == d.max_side_length_factor &&
-      max_side_length_percentile == d.max_side_length_percentile &&
-      isolated_point_neighbors == d.isolated_point_neighbors &&
-      isolated_point_factor == d.isolated_point_factor &&
-      max_side_spacing_factor == d.max_side_spacing_factor &&
-      sparse_min_track_length == d.sparse_min_track_length &&
-      sparse_max_error == d.sparse_max_error) {
-    return "";
-  }
-  std::ostringstream s;
-  s.precision(17);
-  s << "proj=" << max_proj_dist << " depth=" << max_depth_dist
-    << " visibility=" << visibility_sigma << " distance=" << distance_sigma_factor
-    << " quality=" << quality_regularization << " side=" << max_side_length_factor << "@"
-    << max_side_length_percentile << " isolated=" << isolated_point_neighbors << "x"
-    << isolated_point_factor << " spacing=" << max_side_spacing_factor
-    << " sparse=" << sparse_min_track_length << "@" << sparse_max_error;
-  return s.str();
+  DelaunayMeshingOptions legacy;
+  legacy.max_proj_dist = 20.0;
+  legacy.max_side_spacing_factor = 10.0;
+  const std::string description = DescribeMeshing(*this);
+  return description == DescribeMeshing(legacy) ? "" : description;
 }
 
 void DelaunayMeshingOptions::Check() const {

@@ -28,10 +28,7 @@ WorkingView MakeWorkingView(const FaceConsistencyView& view, const TriangleMesh&
                             int max_size) {
   const PinholeCamera& c = view.camera;
   Require(view.photo.channels == 3, kWho, "every photo must have 3 channels");
-  const double scale =
-      std::min(1.0, static_cast<double>(max_size) / std::max(c.width, c.height));
-  const int w = std::max(1, static_cast<int>(std::lround(c.width * scale)));
-  const int h = std::max(1, static_cast<int>(std::lround(c.height * scale)));
+  const auto [w, h] = ScaledSize(c.width, c.height, max_size);
   WorkingView out;
   out.camera = c.Resized(w, h);
   out.colour = BoxBlur(ResizeArea(view.photo, w, h), 1);

@@ -33,6 +33,7 @@
 
 #include "fvs/geometry/camera.h"
 #include "fvs/geometry/mesh.h"
+#include "fvs/mvs/mesh_refinement.h"
 #include "fvs/util/image.h"
 
 namespace fvs::mvs {
@@ -52,10 +53,10 @@ struct FaceConsistencyOptions {
   std::string ToString() const;
 };
 
-struct FaceConsistencyView {
-  PinholeCamera camera;  // the mesh's frame
-  Image photo;           // 3 channels in [0, 1], any size (resized here)
-};
+// A photo with its camera in the mesh's frame, as the vertex refinement takes it (so the
+// mesh_refinement stage reads the photos once for both); the photo must have 3 channels
+// here.
+using FaceConsistencyView = MeshRefinementView;
 
 struct FaceConsistencyResult {
   TriangleMesh mesh;      // the input without its inconsistent faces (vertices unchanged)

@@ -54,13 +54,6 @@ Image ToGrey(const Image& photo) {
   return grey;
 }
 
-// Width and height of a photo scaled so its longest side is at most `size`.
-std::pair<int, int> ScaledSize(int width, int height, int size) {
-  const double s = std::min(1.0, static_cast<double>(size) / std::max(width, height));
-  return {std::max(1, static_cast<int>(std::lround(width * s))),
-          std::max(1, static_cast<int>(std::lround(height * s)))};
-}
-
 // Bilinear grey value at COLMAP pixel coordinates (centres at +0.5); false outside.
 bool SampleGrey(const Image& image, double u, double v, double* value) {
   const double x = u - 0.5;
@@ -422,6 +415,12 @@ double Median(std::vector<double> values) {
 }
 
 }  // namespace
+
+std::pair<int, int> ScaledSize(int width, int height, int size) {
+  const double s = std::min(1.0, static_cast<double>(size) / std::max(width, height));
+  return {std::max(1, static_cast<int>(std::lround(width * s))),
+          std::max(1, static_cast<int>(std::lround(height * s)))};
+}
 
 void MeshRefinementOptions::Check() const {
   Require(max_image_size >= 16, kWho, "--Refine.max_image_size must be >= 16");
