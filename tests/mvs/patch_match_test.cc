@@ -256,6 +256,69 @@ TEST(PatchMatchTest, TexturelessPixelsGetNoDepth) {
   for (float n : map.normal.data) EXPECT_EQ(n, 0.f);
 }
 
+// The pipeline's two passes: photometric maps of every view (unfiltered), then the
+// geometric pass of `ref` against them, filtered.
+DepthNormalMap PhotometricThenGeometric(const std::vector<StereoView>& views, int ref,
+                                        PatchMatchOptions pm) {
+  const int n = static_cast<int>(views.size());
+  pm.filter = false;
+  std::vector<DepthNormalMap> photometric(n);
+  for (int v = 0; v < n; ++v) photometric[v] = PatchMatchView(views, v, AllBut(v, n), pm);
+  std::vector<const Image*> source_depths;
+  for (int s : AllBut(ref, n)) source_depths.push_back(&photometric[s].depth);
+  pm.filter = true;
+  return PatchMatchView(views, ref, AllBut(ref, n), pm, &source_depths, &photometric[ref]);
+}
+
+// Plain tiles with textured grout: the 7x7 window of a tile's centre sees no texture,
+// the same window spread 8x reaches the grout. Spread windows fill the tiles about as
+// accurately as the grout is measured, and leave the grout's pixels their depth.
+TEST(PatchMatchTest, WideWindowsFillPlainTiles) {
+  AnalyticSceneOptions options;
+  options.num_views = 5;
+  options.width = 240;
+  options.height = 180;
+  options.num_sparse_points = 0;
+  options.tile_size = 0.6;
+  const AnalyticScene scene = RenderAnalyticScene(options);
+  const std::vector<StereoView> views = ViewsOf(scene);
+  const int ref = 2;
+  PatchMatchOptions pm;
+  const DepthNormalMap plain = PhotometricThenGeometric(views, ref, pm);
+  pm.max_window_scale = 8;
+  const DepthNormalMap wide = PhotometricThenGeometric(views, ref, pm);
+  const int border = 3;
+  const Image& gt = scene.depths[ref];
+  const Accuracy a = Evaluate(plain, gt, border, "window scale 1");
+  const Accuracy b = Evaluate(wide, gt, border, "window scale 8");
+  EXPECT_LT(b.without_depth, 0.5 * a.without_depth);
+  EXPECT_GT(b.within_1, a.within_1 + 0.1);
+  // Of the pixels only the spread windows give depth, most are right.
+  int added = 0, added_good = 0, lost = 0;
+  for (int y = border; y < gt.height - border; ++y) {
+    for (int x = border; x < gt.width - border; ++x) {
+      const double g = gt.at(x, y), d = wide.depth.at(x, y);
+      ASSERT_TRUE(std::isfinite(d));
+      if (g <= 0) continue;
+      if (plain.depth.at(x, y) > 0) {
+        lost += d <= 0;
+        continue;
+      }
+      if (d <= 0) continue;
+      ++added;
+      added_good += std::abs(d - g) <= 0.01 * g;
+    }
+  }
+  std::printf("added %d px, %.3f within 1%%; lost %d\n", added,
+              static_cast<double>(added_good) / std::max(added, 1), lost);
+  EXPECT_GT(added, 0);
+  EXPECT_GE(added_good, 0.7 * added);  // 0.76 measured; the grout's own kept pixels 0.85
+  EXPECT_LT(lost, 0.05 * added);
+  PatchMatchOptions bad;
+  bad.max_window_scale = 3;
+  EXPECT_THROW(bad.Check(), Error);
+}
+
 TEST(PatchMatchTest, DownscaleGreyAveragesAreas) {
   Image grey(7, 5, 1);
   double sum = 0;

@@ -193,7 +193,12 @@ void WorkspacePreparation::RunDenseStages(StageRunner* stages) {
   stages->Run("stereo", {},
               std::string(builtin_stereo_ ? "builtin" : "colmap") +
                   " size=" + std::to_string(c_.stereo_max_image_size) +
-                  (builtin_stereo_ ? " " + c_.planar_prior.ToString() : ""),
+                  (builtin_stereo_ ? " " + c_.planar_prior.ToString() : "") +
+                  // Only when not 1, so that workspaces prepared before it existed
+                  // keep their fingerprint.
+                  (builtin_stereo_ && c_.stereo_max_window_scale != 1
+                       ? " window_scale=" + std::to_string(c_.stereo_max_window_scale)
+                       : ""),
               {ws_.StereoDir() + "/depth_maps"}, [&] { Stereo(); });
   stages->Run("fusion", {}, FusionFingerprint(c_.fusion_min_num_pixels),
               {ws_.FusedPath(), ws_.FusedVisPath()}, [&] { Fuse(); });
@@ -316,6 +321,7 @@ void WorkspacePreparation::Stereo() {
     mvs::PatchMatchStereoOptions stereo;
     if (c_.stereo_max_image_size > 0) stereo.max_image_size = c_.stereo_max_image_size;
     stereo.planar_prior = c_.planar_prior;
+    stereo.patch_match.max_window_scale = c_.stereo_max_window_scale;
     RunBuiltinStereo(c_.workspace_path, stereo);
     return;
   }
@@ -397,6 +403,9 @@ void PrepareWorkspaceOptions::Check() const {
           who, "--Mesher.backend must be auto, colmap or builtin");
   Require(max_image_size > 0, who, "--max_image_size must be positive");
   Require(stereo_max_image_size >= 0, who, "--Stereo.max_image_size must be >= 0");
+  Require(stereo_max_window_scale >= 1 && stereo_max_window_scale <= 16 &&
+              (stereo_max_window_scale & (stereo_max_window_scale - 1)) == 0,
+          who, "--Stereo.max_window_scale must be 1, 2, 4, 8 or 16");
   Require(fusion_min_num_pixels >= 1, who, "--Fusion.min_num_pixels must be >= 1");
   planar_prior.Check();
   meshing.Check();

@@ -36,6 +36,9 @@ int RunPrepare(int argc, char** argv) {
                      "auto (COLMAP when it has CUDA), colmap, builtin");
   options.AddDefault("Stereo.max_image_size", &o.stereo_max_image_size,
                      "longest side for stereo (0 = undistorted size)");
+  options.AddDefault("Stereo.max_window_scale", &o.stereo_max_window_scale,
+                     "built-in stereo: a textureless pixel's window may spread over up "
+                     "to this many times its side (1, 2, 4, 8, 16; 1 = never)");
   AddPlanarPriorFlags(&options, &o.planar_prior);
   AddDelaunayMeshingFlags(&options, &o.meshing);
   options.AddDefault("Fusion.min_num_pixels", &o.fusion_min_num_pixels,

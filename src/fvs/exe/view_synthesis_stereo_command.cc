@@ -61,6 +61,9 @@ int RunViewSynthesisStereo(int argc, char** argv) {
   options.AddDefault(
       p + "min_texture_std", &pm.min_texture_std,
       "grey std of a window below which a pixel is textureless (no depth)");
+  options.AddDefault(p + "max_window_scale", &pm.max_window_scale,
+                     "a textureless window spreads over up to this many times its side "
+                     "(1, 2, 4, 8, 16; 1 = never)");
   options.AddDefault(p + "geom_consistency_regularizer", &pm.geom_consistency_regularizer,
                      "weight of the reprojection error in the geometric cost");
   options.AddDefault(p + "geom_consistency_max_cost", &pm.geom_consistency_max_cost,

@@ -116,7 +116,7 @@ class ViewSolver {
         [&](int64_t y) {
           for (int x = 0; x < width_; ++x) {
             const size_t i = Index(x, static_cast<int>(y));
-            if (!textured_[i]) continue;
+            if (!window_scale_[i]) continue;
             double d = 0;
             Eigen::Vector3d n = Eigen::Vector3d::Zero();
             if (init && init->depth.data[i] > 0) {
@@ -167,7 +167,7 @@ class ViewSolver {
           std::vector<float> errors(sources_.size());
           for (int x = 0; x < width_; ++x) {
             const size_t i = Index(x, y);
-            if (!textured_[i] || depth_[i] <= 0) continue;
+            if (!window_scale_[i] || depth_[i] <= 0) continue;
             if (options_.filter && !PassesFilter(x, y, &costs, &errors)) continue;
             const Eigen::Vector3d& n = normal_[i];
             if (!std::isfinite(depth_[i]) || !n.allFinite()) continue;
@@ -188,14 +188,14 @@ class ViewSolver {
   // depend on the plane), and the textured mask.
   void PrecomputeReference() {
     const int r = options_.window_radius;
-    pad_ = r;
-    padded_width_ = width_ + 2 * r;
-    const int padded_height = height_ + 2 * r;
+    pad_ = r * options_.max_window_scale;  // the widest window
+    padded_width_ = width_ + 2 * pad_;
+    const int padded_height = height_ + 2 * pad_;
     padded_ref_.resize(static_cast<size_t>(padded_width_) * padded_height);
     for (int y = 0; y < padded_height; ++y) {
-      const int sy = std::clamp(y - r, 0, height_ - 1);
+      const int sy = std::clamp(y - pad_, 0, height_ - 1);
       for (int x = 0; x < padded_width_; ++x) {
-        const int sx = std::clamp(x - r, 0, width_ - 1);
+        const int sx = std::clamp(x - pad_, 0, width_ - 1);
         padded_ref_[static_cast<size_t>(y) * padded_width_ + x] =
             ref_.grey.data[static_cast<size_t>(sy) * width_ + sx];
       }
@@ -227,34 +227,23 @@ class ViewSolver {
     ref_mean_.assign(static_cast<size_t>(width_) * height_, 0.f);
     ref_std_.assign(static_cast<size_t>(width_) * height_, 0.f);
     ref_weight_sum_.assign(static_cast<size_t>(width_) * height_, 0.f);
-    textured_.assign(static_cast<size_t>(width_) * height_, 0);
+    window_scale_.assign(static_cast<size_t>(width_) * height_, 0);
     ParallelFor(
         0, height_,
         [&](int64_t y64) {
           const int y = static_cast<int>(y64);
           for (int x = 0; x < width_; ++x) {
-            double sum = 0, sum_sq = 0;
-            for (int dy : offsets_) {
-              const float* row = RefRow(y + dy);
-              for (int dx : offsets_) {
-                const double v = row[x + dx];
-                sum += v;
-                sum_sq += v * v;
-              }
-            }
-            const double mean = sum / num_samples_;
-            const double var = std::max(0.0, sum_sq / num_samples_ - mean * mean);
             const size_t i = Index(x, y);
-            // The texture test stays unweighted; NCC uses the weighted moments.
-            textured_[i] = std::sqrt(var) >= options_.min_texture_std ? 1 : 0;
+            window_scale_[i] = static_cast<uint8_t>(TexturedScale(x, y));
+            const int scale = std::max<int>(window_scale_[i], 1);
             float weights[kMaxWindowSamples * kMaxWindowSamples];
-            WindowWeights(x, y, weights);
+            WindowWeights(x, y, scale, weights);
             double wsum = 0, wr = 0, wrr = 0;
             int k = 0;
             for (int dy : offsets_) {
-              const float* row = RefRow(y + dy);
+              const float* row = RefRow(y + dy * scale);
               for (int dx : offsets_) {
-                const double v = row[x + dx];
+                const double v = row[x + dx * scale];
                 wsum += weights[k];
                 wr += weights[k] * v;
                 wrr += weights[k] * v * v;
@@ -271,14 +260,36 @@ class ViewSolver {
         options_.num_threads);
   }
 
-  // Bilateral weight of every window sample of pixel (x, y), row by row.
-  void WindowWeights(int x, int y, float* weights) const {
+  // The smallest window scale (1, 2, 4, ... max_window_scale) at which the unweighted
+  // grey std of pixel (x, y)'s window reaches min_texture_std; 0 when none does.
+  int TexturedScale(int x, int y) const {
+    for (int scale = 1; scale <= options_.max_window_scale; scale *= 2) {
+      double sum = 0, sum_sq = 0;
+      for (int dy : offsets_) {
+        const float* row = RefRow(y + dy * scale);
+        for (int dx : offsets_) {
+          const double v = row[x + dx * scale];
+          sum += v;
+          sum_sq += v * v;
+        }
+      }
+      const double mean = sum / num_samples_;
+      const double var = std::max(0.0, sum_sq / num_samples_ - mean * mean);
+      if (std::sqrt(var) >= options_.min_texture_std) return scale;
+    }
+    return 0;
+  }
+
+  // Bilateral weight of every window sample of pixel (x, y) at a window scale, row by
+  // row. The spatial weights are in units of the window's own offsets, so a widened
+  // window weighs its samples as the plain one does.
+  void WindowWeights(int x, int y, int scale, float* weights) const {
     const float centre = RefRow(y)[x];
     int k = 0;
     for (int dy : offsets_) {
-      const float* row = RefRow(y + dy);
+      const float* row = RefRow(y + dy * scale);
       for (int dx : offsets_) {
-        const float diff = std::min(std::abs(row[x + dx] - centre), 1.0f);
+        const float diff = std::min(std::abs(row[x + dx * scale] - centre), 1.0f);
         weights[k] = spatial_weight_[k] *
                      colour_weight_[static_cast<int>(diff * kColourTableSize + 0.5f)];
         ++k;
@@ -315,6 +326,7 @@ class ViewSolver {
   // The reference side of the weighted NCC of one pixel: the same for every source and
   // every candidate plane, so built once per pixel visit.
   struct Window {
+    int scale;  // the pixel's window scale (window_scale_, at least 1)
     float ref_mean, ref_std, inv_weight_sum;
     float weights[kMaxWindowSamples * kMaxWindowSamples];
     float weighted_ref[kMaxWindowSamples * kMaxWindowSamples];
@@ -325,12 +337,14 @@ class ViewSolver {
     window->ref_mean = ref_mean_[i];
     window->ref_std = ref_std_[i];
     window->inv_weight_sum = 1.0f / ref_weight_sum_[i];
-    WindowWeights(x, y, window->weights);
+    window->scale = std::max<int>(window_scale_[i], 1);
+    const int scale = window->scale;
+    WindowWeights(x, y, scale, window->weights);
     int k = 0;
     for (int dy : offsets_) {
-      const float* row = RefRow(y + dy);
+      const float* row = RefRow(y + dy * scale);
       for (int dx : offsets_) {
-        window->weighted_ref[k] = window->weights[k] * row[x + dx];
+        window->weighted_ref[k] = window->weights[k] * row[x + dx * scale];
         ++k;
       }
     }
@@ -397,14 +411,14 @@ class ViewSolver {
     const Eigen::Matrix3f H = Hd.cast<float>();
     // The homography's denominator is affine in (x, y): positive at the four window
     // corners means positive everywhere in between, so the inner loop needs no test.
-    const float r = static_cast<float>(offsets_.back());
-    const float first = static_cast<float>(offsets_.front());
+    const float r = static_cast<float>(offsets_.back() * window.scale);
+    const float first = static_cast<float>(offsets_.front() * window.scale);
     for (float cy : {first, r}) {
       for (float cx : {first, r}) {
         if (!(H(2, 0) * (x + cx) + H(2, 1) * (y + cy) + H(2, 2) > 1e-6f)) return kMaxCost;
       }
     }
-    const float step = static_cast<float>(options_.window_step);
+    const float step = static_cast<float>(options_.window_step * window.scale);
     const float max_u = static_cast<float>(std::max(src.width - 2, 0)) + 0.999f;
     const float max_v = static_cast<float>(std::max(src.height - 2, 0)) + 0.999f;
     const int w = src.width;
@@ -415,7 +429,7 @@ class ViewSolver {
     const float* weights = window.weights;
     const float* weighted_ref = window.weighted_ref;
     for (int row = 0; row < n; ++row) {
-      const int dy = offsets_[row];
+      const int dy = offsets_[row] * window.scale;
       const float sx = static_cast<float>(x) + first, sy = static_cast<float>(y + dy);
       const float hx = H(0, 0) * sx + H(0, 1) * sy + H(0, 2);
       const float hy = H(1, 0) * sx + H(1, 1) * sy + H(1, 2);
@@ -528,7 +542,7 @@ class ViewSolver {
     const double normal_sigma = options_.normal_perturbation * std::pow(0.5, iter);
     for (int x = (y + colour) % 2; x < width_; x += 2) {
       const size_t i = Index(x, y);
-      if (!textured_[i]) continue;
+      if (!window_scale_[i]) continue;
       const Eigen::Vector3d ray = intr_.Ray(x, y);
       Window window;
       MakeWindow(x, y, &window);
@@ -614,7 +628,9 @@ class ViewSolver {
   std::vector<float> ref_mean_, ref_std_, ref_weight_sum_;
   std::vector<float> spatial_weight_;  // per window sample, row by row
   std::vector<float> colour_weight_;   // by |grey difference| * kColourTableSize
-  std::vector<uint8_t> textured_;
+  // Per pixel: the factor its window's offsets are spread by, 0 = textureless at every
+  // scale (no depth).
+  std::vector<uint8_t> window_scale_;
   std::vector<double> depth_;
   std::vector<Eigen::Vector3d> normal_;
   std::vector<float> cost_;
@@ -681,6 +697,9 @@ void PatchMatchOptions::Check() const {
           "sigma_color and sigma_spatial must be finite");
   Require(min_texture_std >= 0 && std::isfinite(min_texture_std), s,
           "min_texture_std must be >= 0");
+  Require(max_window_scale >= 1 && max_window_scale <= 16 &&
+              (max_window_scale & (max_window_scale - 1)) == 0,
+          s, "max_window_scale must be 1, 2, 4, 8 or 16");
   Require(depth_perturbation > 0 && depth_perturbation < 1, s,
           "depth_perturbation must be in (0, 1)");
   Require(normal_perturbation > 0 && std::isfinite(normal_perturbation), s,

@@ -45,6 +45,11 @@ struct PatchMatchOptions {
   // Pixels whose reference window has a grey standard deviation below this are
   // textureless: NCC says nothing there, so they get no depth.
   double min_texture_std = 0.01;
+  // A pixel whose window is textureless tries the same window spread over 2x, 4x, ...
+  // up to this many times the area's side (a power of two; 1 = never), same number of
+  // samples: the centre of a plain tile reaches the grout around it. The widened window
+  // still scores a plane through the pixel, which is what a plain wall or floor is.
+  int max_window_scale = 1;
   // Relative depth perturbation of the first refinement (halved every iteration).
   double depth_perturbation = 0.05;
   // Normal perturbation (radians-ish, added to the unit normal) of the first refinement.

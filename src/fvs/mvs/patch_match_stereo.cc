@@ -64,24 +64,38 @@ std::string ReadText(const std::string& path) {
   return s.str();
 }
 
-// Geometric maps made with other settings go before any is computed, and the stamp is
-// written first: a run killed after this resumes with only the missing maps.
-void InvalidateStaleGeometricMaps(const colmap::DenseWorkspace& ws,
-                                  const std::string& stamp) {
-  const std::string path = ws.StereoDir() + "/fvs_geometric_options.txt";
-  if (ReadText(path) == stamp + "\n") return;
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() > suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// Maps (those whose names end in one of `suffixes`) made with other settings than
+// `stamp`, recorded in W/stereo/<stamp_file>, go before any is computed, and the stamp
+// is written first: a run killed after this resumes with only the missing maps. A
+// workspace without the file counts as stamped `unstamped` (the settings before the
+// stamp existed).
+void InvalidateStaleMaps(const colmap::DenseWorkspace& ws, const std::string& stamp_file,
+                         const std::string& stamp, const std::string& unstamped,
+                         const std::vector<std::string>& suffixes) {
+  const std::string path = ws.StereoDir() + "/" + stamp_file;
+  const std::string recorded = Exists(path) ? ReadText(path) : unstamped + "\n";
+  if (recorded == stamp + "\n") return;
   for (const std::string dir : {"/depth_maps", "/normal_maps"}) {
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(ws.StereoDir() + dir, ec)) {
       const std::string name = entry.path().filename().string();
-      const std::string suffix = ".geometric.bin";
-      if (name.size() > suffix.size() &&
-          name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
-        fs::remove(entry.path(), ec);
+      for (const std::string& suffix : suffixes) {
+        if (EndsWith(name, suffix)) fs::remove(entry.path(), ec);
       }
     }
   }
   WriteFileAtomic(path, [&](std::ostream& out) { out << stamp << "\n"; });
+}
+
+// The photometric settings added after workspaces existed; those workspaces hold maps
+// made with window scale 1.
+std::string PhotometricOptionsStamp(const PatchMatchOptions& options) {
+  return "photometric max_window_scale=" + std::to_string(options.max_window_scale);
 }
 
 struct ViewSet {
@@ -225,7 +239,13 @@ PatchMatchStereoSummary RunPatchMatchStereo(const std::string& workspace_path,
     }
   }
 
-  // Photometric pass.
+  // Photometric pass. Geometric maps go with the photometric ones they were made from.
+  PatchMatchOptions unstamped;
+  unstamped.max_window_scale = 1;
+  InvalidateStaleMaps(ws, "fvs_photometric_options.txt",
+                      PhotometricOptionsStamp(options.patch_match),
+                      PhotometricOptionsStamp(unstamped),
+                      {".photometric.bin", ".geometric.bin"});
   const bool photometric_filter = !options.geom_consistency && options.patch_match.filter;
   PatchMatchOptions photometric_options = options.patch_match;
   photometric_options.filter = photometric_filter;
@@ -273,7 +293,8 @@ PatchMatchStereoSummary RunPatchMatchStereo(const std::string& workspace_path,
       }
       return photometric_depths.emplace(id, std::move(depth)).first->second;
     };
-    InvalidateStaleGeometricMaps(ws, GeometricOptionsStamp(options));
+    InvalidateStaleMaps(ws, "fvs_geometric_options.txt", GeometricOptionsStamp(options),
+                        "", {".geometric.bin"});
     Progress progress("PatchMatch geometric", summary.num_problems);
     for (const StereoProblem& p : problems) {
       const std::string& name = rec.images.at(p.ref_image_id).name;

@@ -67,7 +67,12 @@ double ValueNoise(double s, double t, int64_t key) {
 }
 
 // Several octaves so that the surfaces are textured at every image size we render.
-double Texture(const Quad& q, double s, double t, uint64_t seed) {
+double Texture(const Quad& q, double s, double t, uint64_t seed, double tile) {
+  if (tile > 0) {
+    const double grout = 0.1 * tile;
+    const bool on_grout = std::fmod(s, tile) < grout || std::fmod(t, tile) < grout;
+    if (!on_grout) return 0.6 * q.brightness;
+  }
   const int64_t key = static_cast<int64_t>(seed) * 131 + q.texture_id * 17;
   const double v = 0.45 * ValueNoise(s / 0.03, t / 0.03, key) +
                    0.35 * ValueNoise(s / 0.08, t / 0.08, key + 1) +
@@ -78,7 +83,7 @@ double Texture(const Quad& q, double s, double t, uint64_t seed) {
 // Nearest surface along a ray: parameter along `dir` (infinity when none) and the grey
 // value.
 double CastRay(const std::vector<Quad>& quads, const Eigen::Vector3d& origin,
-               const Eigen::Vector3d& dir, uint64_t seed, double* grey) {
+               const Eigen::Vector3d& dir, uint64_t seed, double tile, double* grey) {
   double best = std::numeric_limits<double>::infinity();
   for (const Quad& q : quads) {
     const Eigen::Vector3d n = q.Normal();
@@ -90,7 +95,7 @@ double CastRay(const std::vector<Quad>& quads, const Eigen::Vector3d& origin,
     const double s = q.axis_a.dot(p), t = q.axis_b.dot(p);
     if (s < 0 || t < 0 || s > q.length_a || t > q.length_b) continue;
     best = lambda;
-    if (grey) *grey = Texture(q, s, t, seed);
+    if (grey) *grey = Texture(q, s, t, seed, tile);
   }
   return best;
 }
@@ -108,6 +113,8 @@ AnalyticScene RenderAnalyticScene(const AnalyticSceneOptions& options) {
   Require(options.num_views >= 2, "AnalyticScene", "need at least 2 views");
   Require(options.width >= 8 && options.height >= 8, "AnalyticScene", "image too small");
   Require(options.supersampling >= 1, "AnalyticScene", "supersampling must be >= 1");
+  Require(options.tile_size >= 0 && std::isfinite(options.tile_size), "AnalyticScene",
+          "tile_size must be >= 0");
   const std::vector<Quad> quads = SceneQuads();
   AnalyticScene scene;
   const Eigen::Vector3d target(0.1, 0.3, 4.5);
@@ -128,7 +135,7 @@ AnalyticScene RenderAnalyticScene(const AnalyticSceneOptions& options) {
       for (int x = 0; x < cam.width; ++x) {
         const Eigen::Vector3d d0 =
             cam.R.transpose() * cam.PixelToCamera(x + 0.5, y + 0.5, 1.0);
-        const double lambda = CastRay(quads, c, d0, options.seed, nullptr);
+        const double lambda = CastRay(quads, c, d0, options.seed, 0, nullptr);
         // d0 has camera-frame z = 1, so the ray parameter is the depth.
         depth.at(x, y) = std::isfinite(lambda) ? static_cast<float>(lambda) : 0.f;
         double sum = 0;
@@ -138,7 +145,7 @@ AnalyticScene RenderAnalyticScene(const AnalyticSceneOptions& options) {
                 cam.R.transpose() *
                 cam.PixelToCamera(x + (sx + 0.5) / ss, y + (sy + 0.5) / ss, 1.0);
             double g = 0;
-            if (std::isfinite(CastRay(quads, c, d, options.seed, &g))) sum += g;
+            if (std::isfinite(CastRay(quads, c, d, options.seed, options.tile_size, &g))) sum += g;
           }
         }
         const float g = static_cast<float>(sum / (ss * ss));

@@ -1,7 +1,8 @@
 // A small analytic scene for testing and benchmarking the stereo stage: textured planes
 // (a floor, a back wall and a box) seen by a row of cameras, ray-cast with exact depth.
 // The texture is smooth value noise (a few pixels per feature at the rendered size) so
-// that every surface pixel is textured and NCC has something to match.
+// that every surface pixel is textured and NCC has something to match; or plain tiles
+// with textured grout (AnalyticSceneOptions::tile_size).
 #pragma once
 
 #include <cstdint>
@@ -20,6 +21,9 @@ struct AnalyticSceneOptions {
   uint64_t seed = 1;
   int num_sparse_points = 1500;  // surface samples written as the sparse model
   int supersampling = 3;  // per axis, for the colours (depth is the pixel centre's)
+  // > 0: every surface is tiled, plain tiles of this side (world units) with textured
+  // grout lines a tenth as wide between them, the textureless case of a tiled wall.
+  double tile_size = 0;
 };
 
 struct AnalyticScene {
