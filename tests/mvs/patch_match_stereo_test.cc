@@ -231,6 +231,17 @@ TEST(PatchMatchStereoTest, SkipsFinishedImagesAndOverwritesOnRequest) {
   // A workspace from before the stamp existed: its geometric maps are made again.
   fs::remove(dir / "stereo/fvs_geometric_options.txt");
   EXPECT_EQ(RunPatchMatchStereo(dir.path(), options).num_geometric_computed, 2);
+  // A workspace without the photometric stamp was made at window scale 1: kept at 1,
+  // made again at another scale (both passes), then kept.
+  options.patch_match.max_window_scale = 1;
+  EXPECT_EQ(RunPatchMatchStereo(dir.path(), options).num_photometric_computed, 2);
+  fs::remove(dir / "stereo/fvs_photometric_options.txt");
+  EXPECT_EQ(RunPatchMatchStereo(dir.path(), options).num_photometric_computed, 0);
+  options.patch_match.max_window_scale = 4;
+  PatchMatchStereoSummary widened = RunPatchMatchStereo(dir.path(), options);
+  EXPECT_EQ(widened.num_photometric_computed, 2);
+  EXPECT_EQ(widened.num_geometric_computed, 2);
+  EXPECT_EQ(RunPatchMatchStereo(dir.path(), options).num_photometric_computed, 0);
 
   // A killed run leaves an image without its geometric map: only that one is redone.
   fs::remove(ws.DepthMapPath("view_001.png", "geometric"));

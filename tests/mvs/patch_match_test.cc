@@ -284,6 +284,7 @@ TEST(PatchMatchTest, WideWindowsFillPlainTiles) {
   const std::vector<StereoView> views = ViewsOf(scene);
   const int ref = 2;
   PatchMatchOptions pm;
+  pm.max_window_scale = 1;
   const DepthNormalMap plain = PhotometricThenGeometric(views, ref, pm);
   pm.max_window_scale = 8;
   const DepthNormalMap wide = PhotometricThenGeometric(views, ref, pm);
