@@ -201,7 +201,6 @@ class ViewSolver {
       }
     }
     for (int d = -r; d <= r; d += options_.window_step) offsets_.push_back(d);
-    num_samples_ = static_cast<int>(offsets_.size() * offsets_.size());
     // Bilateral weights (as COLMAP): spatial Gaussian per window sample, times a colour
     // Gaussian of the grey difference to the centre pixel, from a table.
     const double sigma_spatial =
@@ -260,21 +259,31 @@ class ViewSolver {
         options_.num_threads);
   }
 
-  // The smallest window scale (1, 2, 4, ... max_window_scale) at which the unweighted
-  // grey std of pixel (x, y)'s window reaches min_texture_std; 0 when none does.
+  // The smallest window scale (1, 2, 4, ... max_window_scale) at which the grey std of
+  // pixel (x, y)'s window reaches min_texture_std; 0 when none does. Scale 1 tests the
+  // plain std (as before widening existed). A widened window tests the bilateral std,
+  // what its NCC sees: a dark gap beside a bright column, or sky beside a roof, takes
+  // the other side's texture at a tiny weight, so it does not count as textured there
+  // and the foreground is not fattened across it.
   int TexturedScale(int x, int y) const {
+    float weights[kMaxWindowSamples * kMaxWindowSamples];
     for (int scale = 1; scale <= options_.max_window_scale; scale *= 2) {
-      double sum = 0, sum_sq = 0;
+      if (scale > 1) WindowWeights(x, y, scale, weights);
+      double sum = 0, sum_sq = 0, weight_sum = 0;
+      int k = 0;
       for (int dy : offsets_) {
         const float* row = RefRow(y + dy * scale);
         for (int dx : offsets_) {
           const double v = row[x + dx * scale];
-          sum += v;
-          sum_sq += v * v;
+          const double w = scale > 1 ? weights[k] : 1.0;
+          sum += w * v;
+          sum_sq += w * v * v;
+          weight_sum += w;
+          ++k;
         }
       }
-      const double mean = sum / num_samples_;
-      const double var = std::max(0.0, sum_sq / num_samples_ - mean * mean);
+      const double mean = sum / weight_sum;
+      const double var = std::max(0.0, sum_sq / weight_sum - mean * mean);
       if (std::sqrt(var) >= options_.min_texture_std) return scale;
     }
     return 0;
@@ -624,7 +633,6 @@ class ViewSolver {
   int pad_ = 0, padded_width_ = 0;
   std::vector<float> padded_ref_;
   std::vector<int> offsets_;
-  int num_samples_ = 0;
   std::vector<float> ref_mean_, ref_std_, ref_weight_sum_;
   std::vector<float> spatial_weight_;  // per window sample, row by row
   std::vector<float> colour_weight_;   // by |grey difference| * kColourTableSize
