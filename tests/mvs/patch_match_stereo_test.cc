@@ -233,8 +233,6 @@ TEST(PatchMatchStereoTest, SkipsFinishedImagesAndOverwritesOnRequest) {
   EXPECT_EQ(RunPatchMatchStereo(dir.path(), options).num_geometric_computed, 2);
   // A workspace without the photometric stamp was made at window scale 1: kept at 1,
   // made again at another scale (both passes), then kept.
-  options.patch_match.max_window_scale = 1;
-  EXPECT_EQ(RunPatchMatchStereo(dir.path(), options).num_photometric_computed, 2);
   fs::remove(dir / "stereo/fvs_photometric_options.txt");
   EXPECT_EQ(RunPatchMatchStereo(dir.path(), options).num_photometric_computed, 0);
   options.patch_match.max_window_scale = 4;

@@ -34,7 +34,7 @@ struct PrepareWorkspaceOptions {
   std::string mesher_backend = "auto";  // auto (= builtin) | colmap | builtin
   int stereo_max_image_size = 0;        // 0 = full undistorted size
   // mvs::PatchMatchOptions::max_window_scale of the built-in stereo.
-  int stereo_max_window_scale = 8;
+  int stereo_max_window_scale = 1;
   // COLMAP stereo_fusion's --StereoFusion.min_num_pixels: the views whose depth must
   // agree on a point before it is fused.
   int fusion_min_num_pixels = 5;
