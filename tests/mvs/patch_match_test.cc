@@ -117,6 +117,24 @@ TEST(PatchMatchTest, PlaneHomographyMapsPointsOfThePlane) {
   EXPECT_NEAR(h.y() / h.z(), expected.y(), 1e-9);
 }
 
+// The pipeline's two passes: photometric maps of every view (unfiltered), then the
+// geometric pass of `ref` against them, filtered. `ref_photometric`, when given,
+// receives ref's photometric map.
+DepthNormalMap PhotometricThenGeometric(const std::vector<StereoView>& views, int ref,
+                                        PatchMatchOptions pm,
+                                        DepthNormalMap* ref_photometric = nullptr) {
+  const int n = static_cast<int>(views.size());
+  pm.filter = false;
+  std::vector<DepthNormalMap> photometric(n);
+  for (int v = 0; v < n; ++v) photometric[v] = PatchMatchView(views, v, AllBut(v, n), pm);
+  std::vector<const Image*> source_depths;
+  for (int s : AllBut(ref, n)) source_depths.push_back(&photometric[s].depth);
+  pm.filter = true;
+  if (ref_photometric) *ref_photometric = photometric[ref];
+  return PatchMatchView(views, ref, AllBut(ref, n), pm, &source_depths,
+                        &photometric[ref]);
+}
+
 TEST(PatchMatchTest, PhotometricThenGeometricRecoverExactDepth) {
   AnalyticSceneOptions options;
   options.num_views = 6;
@@ -125,23 +143,18 @@ TEST(PatchMatchTest, PhotometricThenGeometricRecoverExactDepth) {
   options.num_sparse_points = 0;
   const AnalyticScene scene = RenderAnalyticScene(options);
   const std::vector<StereoView> views = ViewsOf(scene);
-  const int n = static_cast<int>(views.size());
-  PatchMatchOptions pm;
-  pm.filter = false;  // photometric maps feed the geometric pass unfiltered, as COLMAP's
-  std::vector<DepthNormalMap> photometric(n);
-  for (int v = 0; v < n; ++v) photometric[v] = PatchMatchView(views, v, AllBut(v, n), pm);
+  const PatchMatchOptions pm;
   const int ref = 2;
   const int border = pm.window_radius;
+  // Photometric maps feed the geometric pass unfiltered, as COLMAP's.
+  DepthNormalMap photometric_ref;
+  const DepthNormalMap geometric =
+      PhotometricThenGeometric(views, ref, pm, &photometric_ref);
   const Accuracy photo =
-      Evaluate(photometric[ref], scene.depths[ref], border, "photometric");
+      Evaluate(photometric_ref, scene.depths[ref], border, "photometric");
   EXPECT_GE(photo.within_1, 0.85);
   EXPECT_EQ(photo.without_depth, 0.0);  // every pixel of this scene is textured
 
-  std::vector<const Image*> source_depths;
-  for (int s : AllBut(ref, n)) source_depths.push_back(&photometric[s].depth);
-  pm.filter = true;
-  const DepthNormalMap geometric =
-      PatchMatchView(views, ref, AllBut(ref, n), pm, &source_depths, &photometric[ref]);
   const Accuracy geo = Evaluate(geometric, scene.depths[ref], border, "geometric+filter");
   EXPECT_GE(geo.within_1, 0.85);
   // Filtering removes mostly wrong pixels: what is kept is more accurate.
@@ -254,20 +267,6 @@ TEST(PatchMatchTest, TexturelessPixelsGetNoDepth) {
   const DepthNormalMap map = PatchMatchView(views, 0, {1}, pm);
   for (float d : map.depth.data) EXPECT_EQ(d, 0.f);
   for (float n : map.normal.data) EXPECT_EQ(n, 0.f);
-}
-
-// The pipeline's two passes: photometric maps of every view (unfiltered), then the
-// geometric pass of `ref` against them, filtered.
-DepthNormalMap PhotometricThenGeometric(const std::vector<StereoView>& views, int ref,
-                                        PatchMatchOptions pm) {
-  const int n = static_cast<int>(views.size());
-  pm.filter = false;
-  std::vector<DepthNormalMap> photometric(n);
-  for (int v = 0; v < n; ++v) photometric[v] = PatchMatchView(views, v, AllBut(v, n), pm);
-  std::vector<const Image*> source_depths;
-  for (int s : AllBut(ref, n)) source_depths.push_back(&photometric[s].depth);
-  pm.filter = true;
-  return PatchMatchView(views, ref, AllBut(ref, n), pm, &source_depths, &photometric[ref]);
 }
 
 // Plain tiles with textured grout: the 7x7 window of a tile's centre sees no texture,

@@ -16,6 +16,7 @@
 #include "fvs/controllers/sfm_steps.h"
 #include "fvs/controllers/stage_runner.h"
 #include "fvs/controllers/workspace_stages.h"
+#include "fvs/mvs/patch_match.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
 #include "fvs/util/string_util.h"
@@ -403,9 +404,8 @@ void PrepareWorkspaceOptions::Check() const {
           who, "--Mesher.backend must be auto, colmap or builtin");
   Require(max_image_size > 0, who, "--max_image_size must be positive");
   Require(stereo_max_image_size >= 0, who, "--Stereo.max_image_size must be >= 0");
-  Require(stereo_max_window_scale >= 1 && stereo_max_window_scale <= 16 &&
-              (stereo_max_window_scale & (stereo_max_window_scale - 1)) == 0,
-          who, "--Stereo.max_window_scale must be 1, 2, 4, 8 or 16");
+  Require(mvs::IsValidWindowScale(stereo_max_window_scale), who,
+          "--Stereo.max_window_scale must be 1, 2, 4, 8 or 16");
   Require(fusion_min_num_pixels >= 1, who, "--Fusion.min_num_pixels must be >= 1");
   planar_prior.Check();
   meshing.Check();

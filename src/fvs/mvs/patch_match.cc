@@ -234,26 +234,12 @@ class ViewSolver {
           for (int x = 0; x < width_; ++x) {
             const size_t i = Index(x, y);
             window_scale_[i] = static_cast<uint8_t>(TexturedScale(x, y));
-            const int scale = std::max<int>(window_scale_[i], 1);
-            float weights[kMaxWindowSamples * kMaxWindowSamples];
-            WindowWeights(x, y, scale, weights);
-            double wsum = 0, wr = 0, wrr = 0;
-            int k = 0;
-            for (int dy : offsets_) {
-              const float* row = RefRow(y + dy * scale);
-              for (int dx : offsets_) {
-                const double v = row[x + dx * scale];
-                wsum += weights[k];
-                wr += weights[k] * v;
-                wrr += weights[k] * v * v;
-                ++k;
-              }
-            }
-            const double wmean = wr / wsum;
-            const double wvar = std::max(0.0, wrr / wsum - wmean * wmean);
-            ref_mean_[i] = static_cast<float>(wmean);
-            ref_std_[i] = static_cast<float>(std::sqrt(wvar));
-            ref_weight_sum_[i] = static_cast<float>(wsum);
+            // NCC uses the bilateral moments of the window it scores.
+            const Moments m =
+                WindowMoments(x, y, std::max<int>(window_scale_[i], 1), true);
+            ref_mean_[i] = static_cast<float>(m.mean);
+            ref_std_[i] = static_cast<float>(m.std);
+            ref_weight_sum_[i] = static_cast<float>(m.weight_sum);
           }
         },
         options_.num_threads);
@@ -266,27 +252,39 @@ class ViewSolver {
   // the other side's texture at a tiny weight, so it does not count as textured there
   // and the foreground is not fattened across it.
   int TexturedScale(int x, int y) const {
-    float weights[kMaxWindowSamples * kMaxWindowSamples];
     for (int scale = 1; scale <= options_.max_window_scale; scale *= 2) {
-      if (scale > 1) WindowWeights(x, y, scale, weights);
-      double sum = 0, sum_sq = 0, weight_sum = 0;
-      int k = 0;
-      for (int dy : offsets_) {
-        const float* row = RefRow(y + dy * scale);
-        for (int dx : offsets_) {
-          const double v = row[x + dx * scale];
-          const double w = scale > 1 ? weights[k] : 1.0;
-          sum += w * v;
-          sum_sq += w * v * v;
-          weight_sum += w;
-          ++k;
-        }
+      if (WindowMoments(x, y, scale, scale > 1).std >= options_.min_texture_std) {
+        return scale;
       }
-      const double mean = sum / weight_sum;
-      const double var = std::max(0.0, sum_sq / weight_sum - mean * mean);
-      if (std::sqrt(var) >= options_.min_texture_std) return scale;
     }
     return 0;
+  }
+
+  struct Moments {
+    double mean, std, weight_sum;
+  };
+
+  // Grey mean and std of pixel (x, y)'s window at a scale, with the bilateral weights
+  // or with unit weights.
+  Moments WindowMoments(int x, int y, int scale, bool bilateral) const {
+    float weights[kMaxWindowSamples * kMaxWindowSamples];
+    if (bilateral) WindowWeights(x, y, scale, weights);
+    double sum = 0, sum_sq = 0, weight_sum = 0;
+    int k = 0;
+    for (int dy : offsets_) {
+      const float* row = RefRow(y + dy * scale);
+      for (int dx : offsets_) {
+        const double v = row[x + dx * scale];
+        const double w = bilateral ? weights[k] : 1.0;
+        sum += w * v;
+        sum_sq += w * v * v;
+        weight_sum += w;
+        ++k;
+      }
+    }
+    const double mean = sum / weight_sum;
+    const double var = std::max(0.0, sum_sq / weight_sum - mean * mean);
+    return {mean, std::sqrt(var), weight_sum};
   }
 
   // Bilateral weight of every window sample of pixel (x, y) at a window scale, row by
@@ -689,6 +687,10 @@ Image DownscaleGrey(const Image& grey, int width, int height) {
   return out;
 }
 
+bool IsValidWindowScale(int scale) {
+  return scale >= 1 && scale <= 16 && (scale & (scale - 1)) == 0;
+}
+
 void PatchMatchOptions::Check() const {
   const std::string s = "PatchMatchStereo";
   Require(window_radius >= 1 && window_radius <= 20, s,
@@ -705,9 +707,8 @@ void PatchMatchOptions::Check() const {
           "sigma_color and sigma_spatial must be finite");
   Require(min_texture_std >= 0 && std::isfinite(min_texture_std), s,
           "min_texture_std must be >= 0");
-  Require(max_window_scale >= 1 && max_window_scale <= 16 &&
-              (max_window_scale & (max_window_scale - 1)) == 0,
-          s, "max_window_scale must be 1, 2, 4, 8 or 16");
+  Require(IsValidWindowScale(max_window_scale), s,
+          "max_window_scale must be 1, 2, 4, 8 or 16");
   Require(depth_perturbation > 0 && depth_perturbation < 1, s,
           "depth_perturbation must be in (0, 1)");
   Require(normal_perturbation > 0 && std::isfinite(normal_perturbation), s,

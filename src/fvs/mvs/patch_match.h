@@ -91,6 +91,9 @@ struct PatchMatchOptions {
   void Check() const;
 };
 
+// Whether `scale` is a PatchMatchOptions::max_window_scale: 1, 2, 4, 8 or 16.
+bool IsValidWindowScale(int scale);
+
 // One view at the working resolution.
 struct StereoView {
   std::string name;
