@@ -416,12 +416,6 @@ double Median(std::vector<double> values) {
 
 }  // namespace
 
-std::pair<int, int> ScaledSize(int width, int height, int size) {
-  const double s = std::min(1.0, static_cast<double>(size) / std::max(width, height));
-  return {std::max(1, static_cast<int>(std::lround(width * s))),
-          std::max(1, static_cast<int>(std::lround(height * s)))};
-}
-
 void MeshRefinementOptions::Check() const {
   Require(max_image_size >= 16, kWho, "--Refine.max_image_size must be >= 16");
   Require(num_levels >= 1 && num_levels <= 6, kWho,

@@ -37,7 +37,6 @@
 #pragma once
 
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "fvs/geometry/camera.h"
@@ -76,10 +75,6 @@ struct MeshRefinementView {
   PinholeCamera camera;  // the mesh's frame
   Image photo;           // 1 or 3 channels in [0, 1], any size (resized here)
 };
-
-// Width and height of a photo scaled so its longest side is at most `size` (never
-// enlarged, at least 1 x 1): the working size of the photo-consistency stages.
-std::pair<int, int> ScaledSize(int width, int height, int size);
 
 struct MeshRefinementResult {
   TriangleMesh mesh;  // moved (and added) vertices, their colours, faces; no normals

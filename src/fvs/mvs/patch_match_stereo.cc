@@ -17,6 +17,7 @@
 #include "fvs/mvs/stereo_config.h"
 #include "fvs/util/atomic_file.h"
 #include "fvs/util/error.h"
+#include "fvs/util/image_resize.h"
 #include "fvs/util/parallel.h"
 #include "fvs/util/progress.h"
 
@@ -199,13 +200,10 @@ PatchMatchStereoSummary RunPatchMatchStereo(const std::string& workspace_path,
                   "image is " + std::to_string(grey.width) + "x" +
                       std::to_string(grey.height) + " but its camera is " +
                       std::to_string(camera.width) + "x" + std::to_string(camera.height));
-          const int longest = std::max(camera.width, camera.height);
-          if (options.max_image_size > 0 && longest > options.max_image_size) {
-            const double scale = static_cast<double>(options.max_image_size) / longest;
-            const int w =
-                std::max(2, static_cast<int>(std::lround(camera.width * scale)));
-            const int h =
-                std::max(2, static_cast<int>(std::lround(camera.height * scale)));
+          if (options.max_image_size > 0 &&
+              std::max(camera.width, camera.height) > options.max_image_size) {
+            const auto [w, h] =
+                ScaledSize(camera.width, camera.height, options.max_image_size, 2);
             grey = DownscaleGrey(grey, w, h);
             camera = camera.Resized(w, h);
           }

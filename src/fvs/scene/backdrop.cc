@@ -78,10 +78,8 @@ std::vector<SmallView> MakeSmallViews(const std::vector<BackdropView>& views,
         const BackdropView& v = views[i];
         Require(v.photo.channels == 3 && !v.photo.empty(), "backdrop",
                 "a photo is empty or not RGB");
-        const double s = std::min(1.0, static_cast<double>(options.max_image_size) /
-                                           std::max(v.camera.width, v.camera.height));
-        const int w = std::max(4, static_cast<int>(std::lround(v.camera.width * s)));
-        const int h = std::max(4, static_cast<int>(std::lround(v.camera.height * s)));
+        const auto [w, h] =
+            ScaledSize(v.camera.width, v.camera.height, options.max_image_size, 4);
         small[i].camera = v.camera.Resized(w, h);
         small[i].photo = ResizeArea(v.photo, w, h);
         RasterizeOptions raster;

@@ -105,11 +105,9 @@ std::string PhotoQualityReport::Summary(int max_names) const {
 double Sharpness(const Image& photo) {
   if (photo.width < 3 || photo.height < 3) return 0;
   Image grey = Grey(photo);
-  const int longest = std::max(grey.width, grey.height);
-  if (longest > kSharpnessSize) {
-    const double s = static_cast<double>(kSharpnessSize) / longest;
-    grey = ResizeArea(grey, std::max(3, static_cast<int>(std::lround(grey.width * s))),
-                      std::max(3, static_cast<int>(std::lround(grey.height * s))));
+  if (std::max(grey.width, grey.height) > kSharpnessSize) {
+    const auto [w, h] = ScaledSize(grey.width, grey.height, kSharpnessSize, 3);
+    grey = ResizeArea(grey, w, h);
   }
   double sum = 0;
   for (int y = 1; y + 1 < grey.height; ++y) {

@@ -7,6 +7,13 @@
 #include "fvs/util/error.h"
 
 namespace fvs {
+
+std::pair<int, int> ScaledSize(int width, int height, int max_side, int min_side) {
+  const double s = std::min(1.0, static_cast<double>(max_side) / std::max(width, height));
+  return {std::max(min_side, static_cast<int>(std::lround(width * s))),
+          std::max(min_side, static_cast<int>(std::lround(height * s)))};
+}
+
 namespace {
 
 // Weights of input samples [0, in) for each output sample along one axis: the overlap of
